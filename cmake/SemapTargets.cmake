@@ -1,0 +1,100 @@
+# Helpers that give every project target the same warnings, layout and labels.
+
+set(SEMAP_WARNINGS -Wall -Wextra -Wpedantic -Werror)
+
+foreach(lib common firmware_bridge drivers estimation mapping dds_idl)
+  if(SEMAP_ONLY STREQUAL "" OR lib IN_LIST SEMAP_ONLY)
+    set(semap_wants_${lib} TRUE)
+  else()
+    set(semap_wants_${lib} FALSE)
+  endif()
+endforeach()
+
+# semap_library(NAME SOURCES ... [PUBLIC_LIBS ...] [PRIVATE_LIBS ...])
+# Creates semap_<NAME> (alias semap::<NAME>) with include/ as its public header root.
+function(semap_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_LIBS;PRIVATE_LIBS" ${ARGN})
+  add_library(semap_${name} ${ARG_SOURCES})
+  add_library(semap::${name} ALIAS semap_${name})
+  target_include_directories(semap_${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_compile_options(semap_${name} PRIVATE ${SEMAP_WARNINGS})
+  target_link_libraries(semap_${name} PUBLIC ${ARG_PUBLIC_LIBS} PRIVATE ${ARG_PRIVATE_LIBS})
+endfunction()
+
+# semap_executable(NAME SOURCES ... LIBS ...): an app in build/bin.
+function(semap_executable name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_compile_options(${name} PRIVATE ${SEMAP_WARNINGS})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS})
+endfunction()
+
+# semap_test(NAME SOURCES ... LIBS ... [LABELS ...] [TIMEOUT s] [ENV ...])
+# A GoogleTest binary registered as one ctest test per binary (keeps ctest output short).
+function(semap_test name)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS;ENV" ${ARGN})
+  find_package(GTest REQUIRED)
+  add_executable(${name} ${ARG_SOURCES})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  target_compile_options(${name} PRIVATE ${SEMAP_WARNINGS})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gmock GTest::gtest_main)
+  target_compile_definitions(${name} PRIVATE
+    SEMAP_SHARED_DATA_DIR="${PROJECT_SOURCE_DIR}/../shared/data"
+    SEMAP_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  if(NOT ARG_LABELS)
+    set(ARG_LABELS unit)
+  endif()
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 300)
+  endif()
+  add_test(NAME ${name} COMMAND ${name})
+  set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT})
+  if(ARG_ENV)
+    set_tests_properties(${name} PROPERTIES ENVIRONMENT "${ARG_ENV}")
+  endif()
+endfunction()
+
+# semap_bench(NAME SOURCES ... LIBS ...): a Google Benchmark binary in build/bin.
+function(semap_bench name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  find_package(benchmark REQUIRED)
+  add_executable(${name} ${ARG_SOURCES})
+  target_compile_options(${name} PRIVATE ${SEMAP_WARNINGS})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} benchmark::benchmark)
+endfunction()
+
+# semap_fuzz(NAME SOURCES ... LIBS ... [CORPUS dir])
+# With SEMAP_FUZZ (clang preset `fuzz`) a libFuzzer binary; otherwise the same entry point
+# linked with a replay main that runs the seed corpus, so every build exercises the target.
+function(semap_fuzz name)
+  cmake_parse_arguments(ARG "" "CORPUS" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
+  target_compile_options(${name} PRIVATE ${SEMAP_WARNINGS})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS})
+  if(SEMAP_FUZZ)
+    target_compile_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
+    target_link_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
+  else()
+    target_sources(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/fuzz/replay_main.cpp)
+    if(ARG_CORPUS)
+      add_test(NAME ${name}_replay COMMAND ${name} ${ARG_CORPUS})
+      set_tests_properties(${name}_replay PROPERTIES LABELS "fuzz;unit" TIMEOUT 120)
+    endif()
+  endif()
+endfunction()
+
+# Adds every immediate subfolder of DIR that has a CMakeLists.txt, so each area owns its own.
+function(semap_add_subfolders dir)
+  file(GLOB children RELATIVE ${CMAKE_CURRENT_SOURCE_DIR}/${dir}
+       CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${dir}/*/CMakeLists.txt)
+  list(SORT children)
+  foreach(child IN LISTS children)
+    get_filename_component(sub ${child} DIRECTORY)
+    # Area folders named after a library are skipped when that library is not built.
+    if(DEFINED semap_wants_${sub} AND NOT semap_wants_${sub})
+      continue()
+    endif()
+    add_subdirectory(${dir}/${sub})
+  endforeach()
+endfunction()
