@@ -1,0 +1,138 @@
+#include "estimation_stage.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <vector>
+
+namespace semap::onboard {
+
+EstimationStage::EstimationStage(const OnboardConfig& config,
+                                 common::SpscRing<common::ImuSample>& imu,
+                                 common::SpscRing<common::GnssFix>& gnss,
+                                 common::SpscRing<mapping::LabeledDepthImage>& images,
+                                 common::SpscRing<common::LabeledCloud>& clouds, PoseSink pose_sink)
+    : config_(config),
+      imu_ring_(imu),
+      gnss_ring_(gnss),
+      image_ring_(images),
+      cloud_ring_(clouds),
+      pose_sink_(std::move(pose_sink)),
+      estimator_(config.estimator),
+      body_from_optical_(config.camera.body_from_optical()) {}
+
+EstimationStage::~EstimationStage() { stop(); }
+
+void EstimationStage::start() {
+  thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+}
+
+void EstimationStage::stop() {
+  if (thread_.joinable()) {
+    thread_.request_stop();
+    thread_.join();
+  }
+}
+
+EstimationStageStats EstimationStage::stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return shared_;
+}
+
+void EstimationStage::run(std::stop_token stop) {
+  while (!stop.stop_requested()) {
+    const bool busy = drain_sensors();
+    pose_images();
+    publish_pose();
+    share_stats();
+    if (!busy) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  share_stats();
+}
+
+// Feeds what the rings hold in stamp order: the IMU and GNSS drivers run on separate threads,
+// so a fix may be popped before IMU samples that precede it.
+bool EstimationStage::drain_sensors() {
+  std::array<common::ImuSample, 64> imu_batch;
+  std::array<common::GnssFix, 8> gnss_batch;
+  const std::size_t n_imu = imu_ring_.try_pop_batch(imu_batch);
+  const std::size_t n_gnss = gnss_ring_.try_pop_batch(gnss_batch);
+  std::size_t i = 0;
+  std::size_t g = 0;
+  while (i < n_imu || g < n_gnss) {
+    if (g < n_gnss && (i == n_imu || gnss_batch[g].stamp <= imu_batch[i].stamp)) {
+      estimator_.add_gnss(gnss_batch[g++]);
+      ++local_.gnss_fixes;
+    } else {
+      last_imu_ = imu_batch[i];
+      estimator_.add_imu(imu_batch[i++]);
+      ++local_.imu_samples;
+    }
+  }
+  mapping::LabeledDepthImage image;
+  while (image_ring_.try_pop(image)) {
+    pending_images_.push_back(std::move(image));
+    ++local_.images;
+  }
+  return n_imu + n_gnss > 0;
+}
+
+void EstimationStage::pose_images() {
+  const auto newest = estimator_.initialised() ? estimator_.estimate() : std::nullopt;
+  while (!pending_images_.empty()) {
+    auto& image = pending_images_.front();
+    if (newest && image.stamp > newest->stamp) return;  // the filter has not got there yet
+    const auto pose = estimator_.pose_at(image.stamp);
+    if (!pose) {
+      ++local_.images_without_pose;
+      pending_images_.pop_front();
+      continue;
+    }
+    Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
+    world_from_body.linear() = pose->orientation.toRotationMatrix().cast<float>();
+    world_from_body.translation() = pose->position.cast<float>();
+    auto cloud = mapping::back_project(image, config_.camera.intrinsics,
+                                       world_from_body * body_from_optical_, config_.camera.stride,
+                                       config_.camera.max_range);
+    cloud.num_classes = static_cast<std::uint16_t>(config_.map.num_classes);
+    cloud_ring_.try_push(std::move(cloud));
+    ++local_.images_posed;
+    pending_images_.pop_front();
+  }
+}
+
+void EstimationStage::publish_pose() {
+  if (!pose_sink_ || !estimator_.initialised()) return;
+  const auto estimate = estimator_.estimate();
+  if (!estimate || estimate->stamp < next_pose_publish_) return;
+  next_pose_publish_ = estimate->stamp + 1.0 / config_.dds.odometry_hz;
+  PoseOutput out;
+  out.pose.stamp = estimate->stamp;
+  out.pose.orientation = Eigen::Quaterniond(estimate->state.rotation);
+  out.pose.position = estimate->state.position;
+  out.pose.velocity = estimate->state.velocity;
+  out.angular_velocity_body = last_imu_.gyro - estimate->state.gyro_bias;
+  out.position_covariance = estimate->position_covariance_world;
+  out.rotation_covariance = estimate->rotation_covariance_world;
+  pose_sink_(out);
+  ++local_.poses_published;
+}
+
+void EstimationStage::share_stats() {
+  local_.initialised = estimator_.initialised();
+  local_.estimator = estimator_.counters();
+  if (const auto e = estimator_.estimate()) {
+    estimation::StampedPose p;
+    p.stamp = e->stamp;
+    p.orientation = Eigen::Quaterniond(e->state.rotation);
+    p.position = e->state.position;
+    p.velocity = e->state.velocity;
+    local_.latest = p;
+  }
+  local_.anchor = estimator_.anchor();
+  local_.anchor_offset = estimator_.anchor_offset();
+  std::lock_guard lock(stats_mutex_);
+  shared_ = local_;
+}
+
+}  // namespace semap::onboard

@@ -1,0 +1,211 @@
+// semap-onboard: the robot's main job. Drivers -> rings -> estimation stage (InEKF, image
+// posing) -> mapping stage (S-BKI) -> DDS. With rig.kind: sim it runs on the built-in
+// simulated sensor rig and reports its own accuracy against the simulated truth.
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "dds_outputs.hpp"
+#include "estimation_stage.hpp"
+#include "mapping_stage.hpp"
+#include "onboard_config.hpp"
+#include "semap/common/config.hpp"
+#include "semap/common/logging.hpp"
+#include "semap/drivers/can_imu_driver.hpp"
+#include "semap/drivers/gnss_driver.hpp"
+#include "semap/estimation/geodesy.hpp"
+#include "sim_rig.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop.store(true); }
+
+using semap::common::OverflowPolicy;
+using semap::common::SpscRing;
+
+// Position error of the live estimate against the rig's truth, in the simulator's frame.
+class LiveAccuracy {
+ public:
+  void sample(const semap::onboard::SimRig& rig, const semap::onboard::EstimationStageStats& s) {
+    if (!s.initialised || !s.latest || !s.anchor) return;
+    if (!first_) first_ = s.latest->stamp;
+    if (semap::common::seconds_between(s.latest->stamp, *first_) < 10.0) return;  // settling
+    const auto truth = rig.truth_at(s.latest->stamp);
+    if (!truth) return;
+    const semap::estimation::LocalEnu sim_frame(rig.data().origin);
+    // The filter's frame is anchored at its first good fix (and shifted by re-anchoring).
+    const Eigen::Vector3d anchor = sim_frame.to_enu(*s.anchor);
+    const Eigen::Vector3d estimate = s.latest->position + anchor - s.anchor_offset;
+    const double e2 = (estimate - truth->state.position).squaredNorm();
+    sum_sq_ += e2;
+    max_ = std::max(max_, std::sqrt(e2));
+    ++count_;
+  }
+  bool any() const { return count_ > 0; }
+  double rmse() const { return std::sqrt(sum_sq_ / static_cast<double>(count_)); }
+  double max() const { return max_; }
+  std::size_t count() const { return count_; }
+
+ private:
+  std::optional<semap::common::Stamp> first_;
+  double sum_sq_ = 0.0;
+  double max_ = 0.0;
+  std::size_t count_ = 0;
+};
+
+int run(const semap::onboard::OnboardConfig& config) {
+  using namespace semap;
+  auto log = common::logger("onboard");
+  SpscRing<common::ImuSample> imu_ring(config.imu.ring, OverflowPolicy::kDropOldest);
+  SpscRing<common::GnssFix> gnss_ring(config.gnss.ring, OverflowPolicy::kDropOldest);
+  SpscRing<mapping::LabeledDepthImage> image_ring(config.camera.ring, OverflowPolicy::kDropOldest);
+  SpscRing<common::LabeledCloud> cloud_ring(config.camera.ring, OverflowPolicy::kDropOldest);
+
+  std::unique_ptr<onboard::SimRig> rig;
+  if (config.rig.simulated) rig = std::make_unique<onboard::SimRig>(config, imu_ring, image_ring);
+
+  std::unique_ptr<drivers::GnssDriver> gnss_driver;
+  auto gnss_config = config.gnss.driver;
+  if (rig && !rig->gnss_device().empty()) gnss_config.serial.device = rig->gnss_device();
+  if (gnss_config.serial.device != "pty") {
+    gnss_driver = std::make_unique<drivers::GnssDriver>(gnss_config, gnss_ring);
+  }
+  std::unique_ptr<drivers::CanImuDriver> imu_driver;
+  if (!config.imu.interface.empty()) {
+    imu_driver = std::make_unique<drivers::CanImuDriver>(config.imu.driver, imu_ring);
+  }
+
+  std::unique_ptr<onboard::DdsOutputs> dds;
+  if (config.dds.enabled) dds = std::make_unique<onboard::DdsOutputs>(config);
+
+  onboard::EstimationStage estimation_stage(
+      config, imu_ring, gnss_ring, image_ring, cloud_ring,
+      dds ? onboard::EstimationStage::PoseSink(
+                [&](const onboard::PoseOutput& p) { dds->publish_pose(p); })
+          : nullptr);
+  onboard::MappingStage mapping_stage(
+      config, cloud_ring,
+      dds ? onboard::MappingStage::BlockSink(
+                [&](std::vector<dds_idl::BlockSnapshot>&& b, common::Stamp now) {
+                  dds->publish_blocks(std::move(b), now);
+                })
+          : nullptr);
+
+  if (gnss_driver) gnss_driver->start();
+  if (imu_driver) imu_driver->start();
+  estimation_stage.start();
+  mapping_stage.start();
+  if (rig) rig->start();
+  log->info("running{}", rig ? " on the simulated rig (GNSS via " + rig->gnss_device() + ")" : "");
+
+  LiveAccuracy accuracy;
+  const auto started = common::Stamp::now();
+  auto next_report = started + 5.0;
+  while (!g_stop.load()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const auto est = estimation_stage.stats();
+    if (rig) accuracy.sample(*rig, est);
+    const auto now = common::Stamp::now();
+    if (now >= next_report) {
+      next_report = now + 5.0;
+      const auto map = mapping_stage.stats();
+      log->info("t={:.0f}s imu={} gnss={} init={} images={} scans={} blocks={} odom_out={}",
+                common::seconds_between(now, started), est.imu_samples, est.gnss_fixes,
+                est.initialised, est.images_posed, map.scans, map.map.blocks,
+                dds ? dds->odometry_written() : 0);
+    }
+    if (rig && rig->finished()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the stages drain
+      break;
+    }
+    if (!rig && config.rig.duration_s > 0 &&
+        common::seconds_between(now, started) > config.rig.duration_s) {
+      break;
+    }
+  }
+
+  if (rig) rig->stop();
+  if (imu_driver) imu_driver->stop();
+  if (gnss_driver) gnss_driver->stop();
+  estimation_stage.stop();
+  mapping_stage.stop();
+
+  const auto est = estimation_stage.stats();
+  const auto map = mapping_stage.stats();
+  std::printf("\n== semap-onboard summary ==\n");
+  if (gnss_driver) {
+    const auto g = gnss_driver->stats();
+    std::printf("gnss driver      : %lu fixes, %lu bytes, %lu checksum failures, %lu reconnects\n",
+                g.frames, g.bytes, g.checksum_failures, g.reconnects);
+  }
+  if (imu_driver) {
+    const auto i = imu_driver->stats();
+    std::printf("imu driver       : %lu samples, %lu CRC failures, %lu gaps, %lu reconnects\n",
+                i.frames, i.checksum_failures, i.sequence_gaps, i.reconnects);
+  }
+  std::printf(
+      "estimation       : %lu IMU samples, %lu GNSS fixes (%lu applied, %lu gated out), "
+      "initialised=%s\n",
+      est.imu_samples, est.gnss_fixes, est.estimator.gnss_applied, est.estimator.gnss_rejected,
+      est.initialised ? "yes" : "no");
+  if (accuracy.any()) {
+    std::printf("pose vs truth    : position RMSE %.3f m, max %.3f m over %zu checks\n",
+                accuracy.rmse(), accuracy.max(), accuracy.count());
+  }
+  std::printf("perception       : %lu images posed, %lu without a pose\n", est.images_posed,
+              est.images_without_pose);
+  std::printf(
+      "mapping          : %lu scans, %lu points, insert mean %.1f ms max %.1f ms, "
+      "%zu blocks, %zu observed cells, %.1f bytes/cell\n",
+      map.scans, map.points,
+      map.scans ? 1e3 * map.insert_seconds_total / static_cast<double>(map.scans) : 0.0,
+      1e3 * map.insert_seconds_max, map.map.blocks, map.map.observed_cells,
+      map.map.bytes_per_cell());
+  if (dds) {
+    const auto m = dds->map_counters();
+    std::printf(
+        "dds              : %lu odometry samples, %lu block samples in %lu rounds, "
+        "%lu map clouds\n",
+        dds->odometry_written(), m.blocks_written, m.block_publications, m.clouds_written);
+  }
+  return est.initialised && map.scans > 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"semap-onboard: drivers, InEKF, S-BKI semantic map and DDS on one robot"};
+  std::string config_path;
+  std::optional<double> duration;
+  app.add_option("--config", config_path, "YAML configuration (see config/sim.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--duration", duration, "seconds to run; overrides rig.duration_s (0: Ctrl-C)");
+  CLI11_PARSE(app, argc, argv);
+
+  semap::onboard::OnboardConfig config;
+  try {
+    config = semap::onboard::load_onboard_config(config_path);
+  } catch (const std::exception& e) {
+    std::cerr << "semap-onboard: " << e.what() << "\n";
+    return 2;
+  }
+  if (duration) config.rig.duration_s = *duration;
+  semap::common::setup_logging(config.log_level);
+  if (config.dds.enabled && !config.dds.cyclone_config.empty() && !std::getenv("CYCLONEDDS_URI")) {
+    setenv("CYCLONEDDS_URI", ("file://" + config.dds.cyclone_config.string()).c_str(), 1);
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  try {
+    return run(config);
+  } catch (const std::exception& e) {
+    std::cerr << "semap-onboard: " << e.what() << "\n";
+    return 1;
+  }
+}

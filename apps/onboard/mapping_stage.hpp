@@ -1,0 +1,65 @@
+#pragma once
+
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "onboard_config.hpp"
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/dds_idl/block_snapshot.hpp"
+#include "semap/mapping/semantic_map.hpp"
+
+namespace semap::onboard {
+
+struct MappingStageStats {
+  std::uint64_t scans = 0;
+  std::uint64_t points = 0;
+  std::uint64_t blocks_changed = 0;  // block snapshots handed to the publisher
+  double insert_seconds_total = 0.0;
+  double insert_seconds_max = 0.0;
+  mapping::MapStats map;
+};
+
+// Owns the SemanticMap on its own thread: inserts every posed cloud and hands a snapshot of
+// each block the scan could have touched to the block sink (the DDS map publisher).
+class MappingStage {
+ public:
+  using BlockSink = std::function<void(std::vector<dds_idl::BlockSnapshot>&&, common::Stamp)>;
+
+  MappingStage(const OnboardConfig& config, common::SpscRing<common::LabeledCloud>& clouds,
+               BlockSink sink);
+  ~MappingStage();
+  MappingStage(const MappingStage&) = delete;
+  MappingStage& operator=(const MappingStage&) = delete;
+
+  void start();
+  void stop();
+  MappingStageStats stats() const;
+  // Only after stop(): the map belongs to the stage thread while it runs.
+  const mapping::SemanticMap& map() const { return map_; }
+
+ private:
+  void run(std::stop_token stop);
+  void insert(const common::LabeledCloud& cloud);
+  std::vector<dds_idl::BlockSnapshot> snapshots_near(const common::LabeledCloud& cloud);
+
+  const OnboardConfig& config_;
+  common::SpscRing<common::LabeledCloud>& clouds_;
+  BlockSink sink_;
+  mapping::SemanticMap map_;
+  std::unordered_map<mapping::BlockIndex, std::uint32_t, mapping::BlockIndexHash> versions_;
+  MappingStageStats local_;
+  mutable std::mutex stats_mutex_;
+  MappingStageStats shared_;
+  std::jthread thread_;
+};
+
+// A block of the map in the form the DDS layer publishes.
+dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map,
+                                   const mapping::BlockIndex& index, const mapping::Block& block,
+                                   std::uint32_t version);
+
+}  // namespace semap::onboard

@@ -1,0 +1,130 @@
+#include "onboard_config.hpp"
+
+#include <numbers>
+
+#include "semap/common/config.hpp"
+
+namespace semap::onboard {
+
+namespace {
+
+using common::ConfigSection;
+
+Eigen::Vector3f vector3(const ConfigSection& s, const std::string& key,
+                        const Eigen::Vector3f& fallback) {
+  if (!s.has(key)) return fallback;
+  const auto v = s.get<std::vector<double>>(key);
+  if (v.size() != 3)
+    throw common::ConfigError(s.file() + ": key '" + s.path() + "." + key +
+                              "': expected 3 numbers");
+  return Eigen::Vector3f(static_cast<float>(v[0]), static_cast<float>(v[1]),
+                         static_cast<float>(v[2]));
+}
+
+void read_rig(const ConfigSection& s, RigConfig& rig) {
+  rig.simulated = s.get_choice("kind", "sim", {"sim", "hardware"}) == "sim";
+  rig.duration_s = s.get_in_range("duration_s", rig.duration_s, 0.0, 86400.0);
+  auto& t = rig.trajectory;
+  t.scenario = s.get_choice("scenario", "figure8", {"car", "figure8"}) == "car"
+                   ? estimation::Scenario::kCar
+                   : estimation::Scenario::kFigureEight;
+  t.speed_m_s = s.get_in_range("speed_m_s", 5.0, 0.5, 40.0);
+  t.imu_rate_hz = s.get_in_range("imu_rate_hz", 200.0, 50.0, 1000.0);
+  t.gnss_rate_hz = s.get_in_range("gnss_rate_hz", 10.0, 1.0, 20.0);
+  t.gnss_sigma_m = s.get_in_range("gnss_sigma_m", 0.5, 0.01, 10.0);
+  t.static_s = s.get_in_range("static_s", 3.0, 1.0, 60.0);
+  t.seed = static_cast<std::uint64_t>(s.get<int>("seed", 1));
+  rig.obstacles = static_cast<int>(s.get_in_range("obstacles", rig.obstacles, 0, 1000));
+  rig.scene_seed = static_cast<std::uint32_t>(s.get<int>("scene_seed", 7));
+  s.finish();
+}
+
+void read_imu(const ConfigSection& s, ImuSourceConfig& imu) {
+  imu.interface = s.get<std::string>("interface", "");
+  imu.driver.interface = imu.interface;
+  const std::string profile = s.get_choice("profile", "semap", {"semap", "j1939"});
+  imu.driver.decoder.profile = profile == "j1939" ? firmware_bridge::ImuProfile::kJ1939
+                                                  : firmware_bridge::ImuProfile::kSemap;
+  imu.ring = static_cast<std::size_t>(s.get_in_range("ring", 4096, 16, 1 << 20));
+  s.finish();
+}
+
+void read_gnss(const ConfigSection& s, GnssSourceConfig& gnss) {
+  gnss.device = s.get<std::string>("device", "pty");
+  gnss.driver.serial.device = gnss.device;
+  gnss.driver.serial.baud = s.get<int>("baud", 115200);
+  gnss.protocol = s.get_choice("protocol", "nmea", {"nmea", "ubx"}) == "ubx"
+                      ? firmware_bridge::GnssProtocol::kUbx
+                      : firmware_bridge::GnssProtocol::kNmea;
+  if (s.has("lever_arm")) gnss.lever_arm = vector3(s, "lever_arm", Eigen::Vector3f::Zero());
+  gnss.ring = static_cast<std::size_t>(s.get_in_range("ring", 256, 16, 65536));
+  s.finish();
+}
+
+void read_camera(const ConfigSection& s, CameraConfig& cam) {
+  const int width = static_cast<int>(s.get_in_range("width", 96, 8, 4096));
+  const int height = static_cast<int>(s.get_in_range("height", 64, 8, 4096));
+  const double fov = s.get_in_range("fov_deg", 90.0, 10.0, 170.0);
+  cam.intrinsics = mapping::PinholeIntrinsics::from_fov(
+      width, height, static_cast<float>(fov * std::numbers::pi / 180.0));
+  cam.rate_hz = s.get_in_range("rate_hz", cam.rate_hz, 0.1, 60.0);
+  cam.max_range = static_cast<float>(s.get_in_range("max_range", cam.max_range, 1.0, 200.0));
+  cam.stride = static_cast<int>(s.get_in_range("stride", cam.stride, 1, 64));
+  cam.mount_xyz = vector3(s, "mount_xyz", cam.mount_xyz);
+  cam.mount_pitch_deg =
+      static_cast<float>(s.get_in_range("mount_pitch_deg", cam.mount_pitch_deg, -90, 90));
+  cam.ring = static_cast<std::size_t>(s.get_in_range("ring", 8, 2, 1024));
+  s.finish();
+}
+
+void read_dds(const ConfigSection& s, const std::filesystem::path& yaml, DdsConfig& dds) {
+  dds.enabled = s.get<bool>("enabled", true);
+  if (s.has("config")) {
+    dds.cyclone_config = s.get<std::string>("config");
+    if (dds.cyclone_config.is_relative()) {
+      dds.cyclone_config = std::filesystem::absolute(yaml).parent_path() / dds.cyclone_config;
+    }
+  }
+  dds.domain = static_cast<int>(s.get_in_range("domain", 0, 0, 232));
+  dds.ns = s.get<std::string>("namespace", "");
+  dds.frame_id = s.get<std::string>("frame_id", "map");
+  dds.publish_hz = s.get_in_range("publish_hz", dds.publish_hz, 0.1, 100.0);
+  dds.cloud_hz = s.get_in_range("cloud_hz", dds.cloud_hz, 0.0, 10.0);
+  dds.odometry_hz = s.get_in_range("odometry_hz", dds.odometry_hz, 1.0, 1000.0);
+  s.finish();
+}
+
+}  // namespace
+
+Eigen::Isometry3f CameraConfig::body_from_optical() const {
+  Eigen::Isometry3f t = Eigen::Isometry3f::Identity();
+  // A positive rotation about the FLU y axis tips the optical axis down.
+  const float pitch = mount_pitch_deg * std::numbers::pi_v<float> / 180.0f;
+  t.linear() = Eigen::AngleAxisf(pitch, Eigen::Vector3f::UnitY()).toRotationMatrix() *
+               mapping::optical_to_flu();
+  t.translation() = mount_xyz;
+  return t;
+}
+
+OnboardConfig load_onboard_config(const std::filesystem::path& path) {
+  const auto root = ConfigSection::load_file(path);
+  OnboardConfig c;
+  c.log_level = root.get_choice("log_level", "info", {"trace", "debug", "info", "warn", "error"});
+  read_rig(root.section_or_empty("rig"), c.rig);
+  read_imu(root.section_or_empty("imu"), c.imu);
+  read_gnss(root.section_or_empty("gnss"), c.gnss);
+  read_camera(root.section_or_empty("camera"), c.camera);
+  c.estimator = estimation::load_estimator_config(root.section_or_empty("estimator"));
+  const auto map = root.section_or_empty("map");
+  c.map = mapping::map_params_from_config(map, c.map);
+  c.map_save_path = map.get<std::string>("save_path", "");
+  c.map_threads = static_cast<int>(map.get_in_range("threads", 2, 1, 64));
+  map.finish();
+  if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
+  read_dds(root.section_or_empty("dds"), path, c.dds);
+  root.finish();
+  c.map.validate();
+  return c;
+}
+
+}  // namespace semap::onboard

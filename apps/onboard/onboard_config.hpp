@@ -1,0 +1,88 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "semap/drivers/can_imu_driver.hpp"
+#include "semap/drivers/gnss_driver.hpp"
+#include "semap/estimation/estimator_config.hpp"
+#include "semap/estimation/simulator.hpp"
+#include "semap/firmware_bridge/emulator.hpp"
+#include "semap/mapping/depth_projection.hpp"
+#include "semap/mapping/map_params.hpp"
+
+namespace semap::onboard {
+
+// The built-in simulated sensor rig (rig.kind: sim).
+struct RigConfig {
+  bool simulated = true;
+  double duration_s = 40.0;  // 0: run until SIGINT
+  estimation::SimulatorConfig trajectory;
+  int obstacles = 60;
+  std::uint32_t scene_seed = 7;
+};
+
+struct ImuSourceConfig {
+  // Empty: the simulated rig hands IMU samples to the pipeline directly (hosts without vcan);
+  // otherwise a CanImuDriver reads this interface (the simulated rig writes to it too).
+  std::string interface;
+  drivers::CanImuConfig driver;
+  std::size_t ring = 4096;
+};
+
+struct GnssSourceConfig {
+  // "pty": the simulated rig opens a pseudo-terminal and the driver reads its slave side.
+  std::string device = "pty";
+  drivers::GnssConfig driver;
+  firmware_bridge::GnssProtocol protocol = firmware_bridge::GnssProtocol::kNmea;
+  std::optional<Eigen::Vector3f> lever_arm;  // antenna in the body frame; overrides estimator's
+  std::size_t ring = 256;
+};
+
+struct CameraConfig {
+  mapping::PinholeIntrinsics intrinsics;
+  double rate_hz = 5.0;
+  float max_range = 20.0f;
+  int stride = 1;                               // back-project every stride-th pixel
+  Eigen::Vector3f mount_xyz{0.3f, 0.0f, 1.5f};  // camera centre in the body frame
+  float mount_pitch_deg = 15.0f;                // downward tilt
+  std::size_t ring = 8;
+
+  // The camera's optical frame in the body frame (shared by the rig and perception).
+  Eigen::Isometry3f body_from_optical() const;
+};
+
+struct DdsConfig {
+  bool enabled = true;
+  // Cyclone XML (relative paths are relative to the YAML file); exported as CYCLONEDDS_URI
+  // unless the environment already sets it.
+  std::filesystem::path cyclone_config;
+  int domain = 0;
+  std::string ns;
+  std::string frame_id = "map";
+  double publish_hz = 2.0;
+  double cloud_hz = 0.5;
+  double odometry_hz = 50.0;
+};
+
+struct OnboardConfig {
+  RigConfig rig;
+  ImuSourceConfig imu;
+  GnssSourceConfig gnss;
+  CameraConfig camera;
+  estimation::EstimatorConfig estimator;
+  mapping::MapParams map;
+  std::string map_save_path;
+  int map_threads = 2;
+  DdsConfig dds;
+  std::string log_level = "info";
+};
+
+// Reads the whole file strictly: unknown keys, wrong types and out-of-range values throw
+// common::ConfigError naming the file, line and key.
+OnboardConfig load_onboard_config(const std::filesystem::path& path);
+
+}  // namespace semap::onboard

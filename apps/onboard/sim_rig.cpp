@@ -1,0 +1,155 @@
+#include "sim_rig.hpp"
+
+#include <fcntl.h>
+#include <pty.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+#include "semap/common/logging.hpp"
+#include "semap/firmware_bridge/linux_can.hpp"
+#include "semap/firmware_bridge/sensor_source.hpp"
+
+namespace semap::onboard {
+
+namespace {
+
+estimation::SimulationData simulate_drive(const OnboardConfig& config) {
+  estimation::SimulatorConfig sim = config.rig.trajectory;
+  // Until SIGINT: ten minutes of drive is plenty for a demo session.
+  const double drive_s = config.rig.duration_s > 0 ? config.rig.duration_s : 600.0;
+  sim.duration_s = drive_s + 1.0;
+  return estimation::simulate(sim);
+}
+
+std::vector<Eigen::Vector3d> path_of(const estimation::SimulationData& data) {
+  std::vector<Eigen::Vector3d> path;
+  path.reserve(data.truth.size());
+  for (const auto& t : data.truth) path.push_back(t.state.position);
+  return path;
+}
+
+void sleep_until(common::Stamp when, std::stop_token stop) {
+  while (!stop.stop_requested()) {
+    const common::Stamp now = common::Stamp::now();
+    if (now >= when) return;
+    const auto wait = std::min<std::int64_t>(when.ns - now.ns, 20'000'000);
+    const timespec ts = common::Stamp(wait).to_timespec();
+    nanosleep(&ts, nullptr);
+  }
+}
+
+}  // namespace
+
+SimRig::SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu_ring,
+               common::SpscRing<mapping::LabeledDepthImage>& depth_ring)
+    : config_(config),
+      imu_ring_(imu_ring),
+      depth_ring_(depth_ring),
+      data_(simulate_drive(config)),
+      scene_(mapping::SyntheticScene::around_path(path_of(data_), 4.0f, config.rig.obstacles,
+                                                  config.rig.scene_seed)),
+      camera_(config.camera.intrinsics, config.camera.max_range),
+      body_from_optical_(config.camera.body_from_optical()) {
+  firmware_bridge::EmulatorConfig emu;
+  emu.gnss_protocol = config.gnss.protocol;
+  emu.speed = 0.0;  // the rig paces events itself
+  if (config.gnss.device == "pty") {
+    int slave = -1;
+    if (openpty(&pty_master_, &slave, nullptr, nullptr, nullptr) != 0) {
+      throw std::runtime_error(std::string("sim rig: openpty failed: ") + std::strerror(errno));
+    }
+    // Raw from the start, so nothing is echoed back before the driver configures the port.
+    termios tio{};
+    tcgetattr(slave, &tio);
+    cfmakeraw(&tio);
+    tcsetattr(slave, TCSANOW, &tio);
+    pty_slave_ = ttyname(slave);
+    // Keep the slave open so the master never sees a hang-up between driver reconnects.
+    pty_slave_fd_ = slave;
+    fcntl(pty_master_, F_SETFL, fcntl(pty_master_, F_GETFL) | O_NONBLOCK);
+    emu.serial_fd = pty_master_;
+  }
+  if (!config.imu.interface.empty()) {
+    can_socket_ = std::make_unique<firmware_bridge::CanSocket>(config.imu.interface, false);
+    emu.can_fd = can_socket_->fd();
+  }
+  emulator_ = std::make_unique<firmware_bridge::Emulator>(emu);
+}
+
+SimRig::~SimRig() {
+  stop();
+  if (pty_slave_fd_ >= 0) ::close(pty_slave_fd_);
+  if (pty_master_ >= 0) ::close(pty_master_);
+}
+
+void SimRig::start() {
+  start_ = common::Stamp::now() + 0.2;
+  thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+}
+
+void SimRig::stop() {
+  if (thread_.joinable()) {
+    thread_.request_stop();
+    thread_.join();
+  }
+}
+
+std::optional<estimation::TruthSample> SimRig::truth_at(common::Stamp stamp) const {
+  const common::Stamp sim(stamp.ns - start_.ns);
+  const auto it = std::lower_bound(data_.truth.begin(), data_.truth.end(), sim,
+                                   [](const auto& t, common::Stamp s) { return t.stamp < s; });
+  if (it == data_.truth.end()) return std::nullopt;
+  return *it;
+}
+
+void SimRig::render_image(const estimation::TruthSample& truth, common::Stamp stamp) {
+  Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
+  world_from_body.linear() = truth.state.rotation.cast<float>();
+  world_from_body.translation() = truth.state.position.cast<float>();
+  depth_ring_.try_push(camera_.render(scene_, world_from_body * body_from_optical_, stamp));
+  images_.fetch_add(1, std::memory_order_acq_rel);
+}
+
+void SimRig::run(std::stop_token stop) {
+  auto log = common::logger("sim_rig");
+  const double duration = config_.rig.duration_s > 0 ? config_.rig.duration_s : 1e12;
+  const double camera_period = 1.0 / config_.camera.rate_hz;
+  double next_camera = data_.truth.empty() ? 0.0 : data_.truth.front().stamp.seconds();
+  firmware_bridge::VectorSource source(data_.imu, data_.gnss);
+  std::size_t imu_index = 0;
+  while (!stop.stop_requested()) {
+    auto event = source.next();
+    if (!event) break;
+    const common::Stamp sim_stamp = std::visit([](const auto& e) { return e.stamp; }, *event);
+    if (sim_stamp.seconds() > duration) break;
+    const common::Stamp wall(start_.ns + sim_stamp.ns);
+    sleep_until(wall, stop);
+    if (auto* imu = std::get_if<common::ImuSample>(&*event)) {
+      if (can_socket_) {
+        emulator_->emit(*event);
+      } else {
+        common::ImuSample restamped = *imu;
+        restamped.stamp = wall;
+        imu_ring_.try_push(restamped);
+      }
+      const auto& truth = data_.truth[std::min(imu_index++, data_.truth.size() - 1)];
+      if (sim_stamp.seconds() >= next_camera) {
+        render_image(truth, wall);
+        next_camera += camera_period;
+      }
+    } else if (pty_master_ >= 0) {
+      emulator_->emit(*event);
+    }
+  }
+  log->info("simulated drive finished: {} IMU samples, {} GNSS epochs, {} images", imu_index,
+            emulator_->stats().gnss_epochs, images_.load());
+  finished_.store(true, std::memory_order_release);
+}
+
+}  // namespace semap::onboard

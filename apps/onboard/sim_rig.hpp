@@ -1,0 +1,67 @@
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <thread>
+
+#include "onboard_config.hpp"
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/estimation/simulator.hpp"
+#include "semap/firmware_bridge/emulator.hpp"
+#include "semap/firmware_bridge/linux_can.hpp"
+#include "semap/mapping/synthetic_depth_camera.hpp"
+#include "semap/mapping/synthetic_scene.hpp"
+
+namespace semap::onboard {
+
+// The built-in simulated sensor rig. It plays a simulated drive in real time: GNSS as NMEA/UBX
+// bytes into a pseudo-terminal (read by the real GnssDriver through termios), IMU as CAN
+// frames on a SocketCAN interface when one is configured (read by the real CanImuDriver) or
+// straight into the IMU ring otherwise, and depth + class images of a synthetic world seen
+// from the true pose. Sensor stamps are CLOCK_MONOTONIC, as real drivers would give them.
+class SimRig {
+ public:
+  SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu_ring,
+         common::SpscRing<mapping::LabeledDepthImage>& depth_ring);
+  ~SimRig();
+  SimRig(const SimRig&) = delete;
+  SimRig& operator=(const SimRig&) = delete;
+
+  // Path of the pty slave the GNSS driver should open (empty when GNSS is not on a pty).
+  const std::string& gnss_device() const { return pty_slave_; }
+
+  void start();
+  void stop();
+  bool finished() const { return finished_.load(std::memory_order_acquire); }
+
+  // Truth at a monotonic stamp (nearest simulated sample), in the simulator's ENU frame.
+  std::optional<estimation::TruthSample> truth_at(common::Stamp stamp) const;
+  const estimation::SimulationData& data() const { return data_; }
+  const mapping::SyntheticScene& scene() const { return scene_; }
+  const firmware_bridge::EmulatorStats& emulator_stats() const { return emulator_->stats(); }
+  std::uint64_t images_rendered() const { return images_.load(std::memory_order_acquire); }
+
+ private:
+  void run(std::stop_token stop);
+  void render_image(const estimation::TruthSample& truth, common::Stamp stamp);
+
+  const OnboardConfig& config_;
+  common::SpscRing<common::ImuSample>& imu_ring_;
+  common::SpscRing<mapping::LabeledDepthImage>& depth_ring_;
+  estimation::SimulationData data_;
+  mapping::SyntheticScene scene_;
+  mapping::SyntheticDepthCamera camera_;
+  Eigen::Isometry3f body_from_optical_;
+  int pty_master_ = -1;
+  int pty_slave_fd_ = -1;
+  std::unique_ptr<firmware_bridge::CanSocket> can_socket_;
+  std::string pty_slave_;
+  std::unique_ptr<firmware_bridge::Emulator> emulator_;
+  common::Stamp start_;
+  std::atomic<bool> finished_{false};
+  std::atomic<std::uint64_t> images_{0};
+  std::jthread thread_;
+};
+
+}  // namespace semap::onboard
