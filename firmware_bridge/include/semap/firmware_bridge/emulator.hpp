@@ -52,6 +52,8 @@ struct EmulatorStats {
   std::uint64_t nmea_sentences = 0;  // complete, untruncated sentences
   std::uint64_t ubx_frames = 0;      // complete, untruncated frames
   std::uint64_t serial_bytes = 0;
+  // Bytes a non-blocking serial fd would not take within 100 ms (a UART overrun).
+  std::uint64_t serial_dropped_bytes = 0;
   InjectedFaults injected;
 };
 
@@ -81,6 +83,9 @@ class Emulator {
   // Sends one event immediately (no pacing).
   void emit(const SensorEvent& event);
 
+  // Changes the faults from the next event on (e.g. a clean tail so a receiver can settle).
+  void set_faults(const FaultConfig& faults) { config_.faults = faults; }
+
   const EmulatorStats& stats() const { return stats_; }
 
  private:
@@ -90,6 +95,7 @@ class Emulator {
   void send_serial(const void* data, std::size_t len);
   bool silenced(common::Stamp stamp) const;
   bool chance(double probability);
+  void send_garbage();
 
   EmulatorConfig config_;
   EmulatorStats stats_;
@@ -97,7 +103,6 @@ class Emulator {
   bool have_first_ = false;
   common::Stamp first_stamp_;
   std::uint8_t sequence_ = 0;
-  std::uint32_t timestamp_origin_us_ = 0;
 };
 
 }  // namespace semap::firmware_bridge
