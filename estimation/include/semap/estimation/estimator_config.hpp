@@ -1,0 +1,57 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <optional>
+
+#include "semap/common/config.hpp"
+#include "semap/estimation/filter_params.hpp"
+#include "semap/estimation/geodesy.hpp"
+#include "semap/estimation/imu_validator.hpp"
+
+namespace semap::estimation {
+
+enum class FilterKind : std::uint8_t { kLeftInekf, kQuaternionEskf };
+
+// Initialisation from a static IMU window plus the first GNSS fix.
+struct InitConfig {
+  double window_s = 1.0;             // static IMU window length
+  double yaw_rad = 0.0;              // heading guess; any error must converge from motion
+  double yaw_sigma_rad = 3.0;        // ~ uniform over the circle
+  double tilt_sigma_rad = 0.03;
+  double velocity_sigma_m_s = 0.2;
+  double gyro_bias_sigma_rad_s = 0.01;
+  double accel_bias_sigma_m_s2 = 0.2;
+  double static_gyro_max_rad_s = 0.05;  // mean |gyro| above this: not static (warned, counted)
+  double static_accel_std_max_m_s2 = 0.3;
+};
+
+// A run of consistent gated-out fixes (a GNSS jump that persists) shifts the anchor.
+struct ReanchorConfig {
+  int after_rejections = 10;  // consecutive rejected fixes
+  double max_spread_m = 3.0;  // residuals must agree within this to count as a jump
+};
+
+struct EstimatorConfig {
+  FilterKind filter = FilterKind::kLeftInekf;
+  FilterParams params;
+  ImuLimits imu_limits;
+  InitConfig init;
+  ReanchorConfig reanchor;
+  double gating_probability = 0.999;
+  Eigen::Vector3d lever_arm = Eigen::Vector3d::Zero();  // GNSS antenna in the body frame, m
+  bool use_gnss_velocity = false;
+  double gnss_velocity_sigma_m_s = 0.1;
+  // IMU samples are held this long before integration so that late GNSS fixes still fit
+  // in time order; the estimate lags by the same amount.
+  double imu_delay_s = 0.0;
+  std::size_t gnss_buffer = 16;
+  std::size_t history = 2048;  // poses kept for pose_at()
+  // Local frame origin; when absent the first good fix anchors it.
+  std::optional<Geodetic> anchor;
+};
+
+// Reads the `estimator:` section (every key optional, unknown keys rejected).
+EstimatorConfig load_estimator_config(const common::ConfigSection& section);
+
+}  // namespace semap::estimation

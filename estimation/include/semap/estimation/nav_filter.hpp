@@ -1,0 +1,45 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "semap/estimation/nav_state.hpp"
+
+namespace semap::estimation {
+
+// Outcome of one measurement update.
+struct CorrectionResult {
+  bool accepted = false;
+  double mahalanobis2 = 0.0;                         // squared Mahalanobis distance
+  Eigen::Vector3d residual = Eigen::Vector3d::Zero();  // measured - predicted, world frame
+};
+
+// The interface both filters share, so the estimator front-end, the evaluation and the
+// tests feed them identical inputs. Each filter keeps its own error convention; error_from()
+// and covariance() are expressed in it, which is what a NEES needs.
+class NavFilter {
+ public:
+  virtual ~NavFilter() = default;
+
+  virtual void reset(const NavState& state, const Matrix15& covariance) = 0;
+  // Zero-order hold of the raw IMU sample (body frame) over dt seconds.
+  virtual void propagate(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel,
+                         double dt) = 0;
+  // GNSS antenna position in the world frame, its covariance (world) and the antenna lever arm
+  // (body). The update is applied only when the Mahalanobis distance is below gate2.
+  virtual CorrectionResult correct_position(const Eigen::Vector3d& position,
+                                            const Eigen::Matrix3d& covariance,
+                                            const Eigen::Vector3d& lever_arm, double gate2) = 0;
+  // Velocity of the body origin in the world frame.
+  virtual CorrectionResult correct_velocity(const Eigen::Vector3d& velocity,
+                                            const Eigen::Matrix3d& covariance, double gate2) = 0;
+
+  virtual NavState state() const = 0;
+  virtual const Matrix15& covariance() const = 0;
+  // Error of this estimate with respect to `truth` in the filter's own error coordinates.
+  virtual Vector15 error_from(const NavState& truth) const = 0;
+  // Covariance of rotation (world axes, rad^2) and position (world, m^2) for reporting.
+  virtual Eigen::Matrix3d rotation_covariance_world() const = 0;
+  virtual Eigen::Matrix3d position_covariance_world() const = 0;
+};
+
+}  // namespace semap::estimation

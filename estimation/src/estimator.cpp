@@ -1,0 +1,265 @@
+#include "semap/estimation/estimator.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "semap/common/logging.hpp"
+#include "semap/estimation/chi_square.hpp"
+#include "semap/estimation/left_inekf.hpp"
+#include "semap/estimation/quaternion_eskf.hpp"
+#include "semap/estimation/so3.hpp"
+
+namespace semap::estimation {
+
+namespace {
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+bool valid_covariance(const Matrix3d& c) {
+  if (!c.allFinite()) return false;
+  return Eigen::LLT<Matrix3d>(c).info() == Eigen::Success;
+}
+}  // namespace
+
+std::unique_ptr<NavFilter> make_filter(FilterKind kind, const FilterParams& params) {
+  if (kind == FilterKind::kQuaternionEskf) return std::make_unique<QuaternionEskf>(params);
+  return std::make_unique<LeftInekf>(params);
+}
+
+Estimator::Estimator(const EstimatorConfig& config)
+    : config_(config),
+      gate2_(chi_square_quantile(config.gating_probability, 3.0)),
+      filter_(make_filter(config.filter, config.params)),
+      validator_(config.imu_limits),
+      gnss_buffer_(config.gnss_buffer),
+      history_(config.history) {
+  if (config.anchor) local_.emplace(*config.anchor);
+}
+
+Estimator::~Estimator() = default;
+
+const EstimatorCounters& Estimator::counters() const {
+  counters_.imu = validator_.counters();
+  counters_.gnss_buffer = gnss_buffer_.counters();
+  return counters_;
+}
+
+std::optional<Geodetic> Estimator::anchor() const {
+  if (!local_) return std::nullopt;
+  return local_->origin();
+}
+
+void Estimator::add_imu(const common::ImuSample& sample) {
+  double dt = 0.0;
+  const ImuVerdict verdict = validator_.check(sample, dt);
+  if (verdict != ImuVerdict::kAccept && verdict != ImuVerdict::kFirst &&
+      verdict != ImuVerdict::kGap) {
+    common::logger("estimation")
+        ->debug("IMU sample {} at {:.6f} s rejected: {}", sample.sequence, sample.stamp.seconds(),
+                to_string(verdict));
+    return;
+  }
+  if (verdict == ImuVerdict::kGap) {
+    common::logger("estimation")
+        ->warn("IMU gap before sample {} at {:.6f} s: restarting integration", sample.sequence,
+               sample.stamp.seconds());
+  }
+  imu_queue_.push_back({sample, verdict != ImuVerdict::kAccept});
+  const common::Stamp release = sample.stamp + (-config_.imu_delay_s);
+  while (!imu_queue_.empty() && imu_queue_.front().sample.stamp <= release) {
+    const QueuedImu next = imu_queue_.front();
+    imu_queue_.pop_front();
+    process_imu(next);
+  }
+}
+
+void Estimator::add_gnss(const common::GnssFix& fix) {
+  ++counters_.gnss_received;
+  if (!fix.valid() || !std::isfinite(fix.latitude_deg) || !std::isfinite(fix.longitude_deg) ||
+      !std::isfinite(fix.altitude_m) || std::abs(fix.latitude_deg) > 90.0 ||
+      std::abs(fix.longitude_deg) > 180.0 || !valid_covariance(fix.covariance)) {
+    ++counters_.gnss_invalid;
+    common::logger("estimation")
+        ->debug("GNSS fix at {:.6f} s ignored: invalid fix or covariance", fix.stamp.seconds());
+    return;
+  }
+  if (!local_) {
+    local_.emplace(Geodetic{fix.latitude_deg, fix.longitude_deg, fix.altitude_m});
+    common::logger("estimation")
+        ->info("local ENU frame anchored at {:.8f}, {:.8f}, {:.2f}", fix.latitude_deg,
+               fix.longitude_deg, fix.altitude_m);
+  }
+  if (!initialised_) {
+    init_fix_ = fix;
+    try_initialise();
+    return;
+  }
+  if (!gnss_buffer_.push(fix, filter_time_)) {
+    common::logger("estimation")
+        ->debug("GNSS fix at {:.6f} s not buffered (late or duplicate; filter at {:.6f} s)",
+                fix.stamp.seconds(), filter_time_.seconds());
+  }
+}
+
+void Estimator::process_imu(const QueuedImu& queued) {
+  const common::ImuSample& s = queued.sample;
+  if (!initialised_) {
+    collect_init_sample(s);
+    return;
+  }
+  if (queued.restart) {
+    filter_time_ = s.stamp;
+    return;
+  }
+  // The sample holds over (filter_time_, s.stamp]; fixes inside it split the interval.
+  while (auto fix = gnss_buffer_.pop_until(s.stamp)) {
+    const double dt = common::seconds_between(fix->stamp, filter_time_);
+    if (dt > 0.0) filter_->propagate(s.gyro, s.accel, dt);
+    filter_time_ = std::max(filter_time_, fix->stamp);
+    apply_gnss(*fix);
+  }
+  const double dt = common::seconds_between(s.stamp, filter_time_);
+  if (dt > 0.0) filter_->propagate(s.gyro, s.accel, dt);
+  filter_time_ = s.stamp;
+  record_pose();
+}
+
+void Estimator::collect_init_sample(const common::ImuSample& sample) {
+  init_window_.push_back(sample);
+  while (init_window_.size() > 2 &&
+         common::seconds_between(sample.stamp, init_window_[1].stamp) >= config_.init.window_s) {
+    init_window_.pop_front();
+  }
+  filter_time_ = sample.stamp;
+  try_initialise();
+}
+
+void Estimator::try_initialise() {
+  if (initialised_ || !init_fix_ || !local_ || init_window_.size() < 2) return;
+  const double span =
+      common::seconds_between(init_window_.back().stamp, init_window_.front().stamp);
+  if (span < config_.init.window_s) return;
+
+  Vector3d mean_gyro = Vector3d::Zero();
+  Vector3d mean_accel = Vector3d::Zero();
+  for (const auto& s : init_window_) {
+    mean_gyro += s.gyro;
+    mean_accel += s.accel;
+  }
+  const double n = static_cast<double>(init_window_.size());
+  mean_gyro /= n;
+  mean_accel /= n;
+  double accel_var = 0.0;
+  for (const auto& s : init_window_) accel_var += (s.accel - mean_accel).squaredNorm();
+  accel_var /= n;
+  const auto& ic = config_.init;
+  if (mean_gyro.norm() > ic.static_gyro_max_rad_s ||
+      std::sqrt(accel_var) > ic.static_accel_std_max_m_s2) {
+    ++counters_.init_not_static;
+    common::logger("estimation")
+        ->warn("initialising from a window that is not static (|gyro| {:.3f} rad/s, accel std "
+               "{:.3f} m/s^2)",
+               mean_gyro.norm(), std::sqrt(accel_var));
+  }
+
+  // At rest the accelerometer measures R^T (0, 0, g): roll and pitch follow from its direction.
+  const double roll = std::atan2(mean_accel.y(), mean_accel.z());
+  const double pitch = std::atan2(-mean_accel.x(), std::hypot(mean_accel.y(), mean_accel.z()));
+  NavState x;
+  x.rotation = rotation_from_rpy(roll, pitch, ic.yaw_rad);
+  x.gyro_bias = mean_gyro;
+  const Geodetic g{init_fix_->latitude_deg, init_fix_->longitude_deg, init_fix_->altitude_m};
+  x.position = local_->to_enu(g) - anchor_offset_ - x.rotation * config_.lever_arm;
+
+  Matrix15 p = Matrix15::Zero();
+  p.block<3, 3>(kRot, kRot).diagonal() << ic.tilt_sigma_rad * ic.tilt_sigma_rad,
+      ic.tilt_sigma_rad * ic.tilt_sigma_rad, ic.yaw_sigma_rad * ic.yaw_sigma_rad;
+  p.block<3, 3>(kVel, kVel) =
+      Matrix3d::Identity() * ic.velocity_sigma_m_s * ic.velocity_sigma_m_s;
+  p.block<3, 3>(kPos, kPos) = init_fix_->covariance;
+  p.block<3, 3>(kGyroBias, kGyroBias) =
+      Matrix3d::Identity() * ic.gyro_bias_sigma_rad_s * ic.gyro_bias_sigma_rad_s;
+  p.block<3, 3>(kAccelBias, kAccelBias) =
+      Matrix3d::Identity() * ic.accel_bias_sigma_m_s2 * ic.accel_bias_sigma_m_s2;
+  filter_->reset(x, p);
+  filter_time_ = init_window_.back().stamp;
+  initialised_ = true;
+  init_window_.clear();
+  init_fix_.reset();
+  record_pose();
+  common::logger("estimation")
+      ->info("initialised at {:.3f} s: roll {:.2f} deg, pitch {:.2f} deg, yaw guess {:.1f} deg",
+             filter_time_.seconds(), roll * 180.0 / std::numbers::pi, pitch * 180.0 / std::numbers::pi,
+             ic.yaw_rad * 180.0 / std::numbers::pi);
+}
+
+void Estimator::apply_gnss(const common::GnssFix& fix) {
+  const Geodetic g{fix.latitude_deg, fix.longitude_deg, fix.altitude_m};
+  const Vector3d y = local_->to_enu(g) - anchor_offset_;
+  const CorrectionResult r =
+      filter_->correct_position(y, fix.covariance, config_.lever_arm, gate2_);
+  if (r.accepted) {
+    ++counters_.gnss_applied;
+    rejected_run_.clear();
+  } else {
+    ++counters_.gnss_rejected;
+    common::logger("estimation")
+        ->log(rejected_run_.empty() ? spdlog::level::warn : spdlog::level::debug,
+              "GNSS fix at {:.3f} s gated out: Mahalanobis^2 {:.1f} >= {:.1f}, residual {:.2f} m",
+              fix.stamp.seconds(), r.mahalanobis2, gate2_, r.residual.norm());
+    note_rejection(r.residual);
+  }
+  if (config_.use_gnss_velocity && fix.velocity_enu && fix.velocity_enu->allFinite()) {
+    const double var = config_.gnss_velocity_sigma_m_s * config_.gnss_velocity_sigma_m_s;
+    const CorrectionResult rv =
+        filter_->correct_velocity(*fix.velocity_enu, Matrix3d::Identity() * var, gate2_);
+    ++(rv.accepted ? counters_.velocity_applied : counters_.velocity_rejected);
+  }
+}
+
+void Estimator::note_rejection(const Vector3d& residual) {
+  rejected_run_.push_back(residual);
+  if (static_cast<int>(rejected_run_.size()) < config_.reanchor.after_rejections) return;
+  Vector3d mean = Vector3d::Zero();
+  for (const auto& r : rejected_run_) mean += r;
+  mean /= static_cast<double>(rejected_run_.size());
+  double spread = 0.0;
+  for (const auto& r : rejected_run_) spread = std::max(spread, (r - mean).norm());
+  if (spread > config_.reanchor.max_spread_m) {
+    // Scattered outliers or a diverging filter, not a jump: keep gating.
+    rejected_run_.erase(rejected_run_.begin());
+    return;
+  }
+  // The receiver's solution moved as a whole: shift the frame so the map stays continuous.
+  anchor_offset_ += mean;
+  ++counters_.reanchors;
+  rejected_run_.clear();
+  common::logger("estimation")
+      ->warn("GNSS jump of {:.2f} m persisted for {} fixes: re-anchored (offset now {:.2f}, "
+             "{:.2f}, {:.2f})",
+             mean.norm(), config_.reanchor.after_rejections, anchor_offset_.x(),
+             anchor_offset_.y(), anchor_offset_.z());
+}
+
+void Estimator::record_pose() {
+  const NavState s = filter_->state();
+  StampedPose pose;
+  pose.stamp = filter_time_;
+  pose.orientation = Eigen::Quaterniond(s.rotation);
+  pose.position = s.position;
+  pose.velocity = s.velocity;
+  history_.push(pose);
+}
+
+std::optional<Estimate> Estimator::estimate() const {
+  if (!initialised_) return std::nullopt;
+  Estimate e;
+  e.stamp = filter_time_;
+  e.state = filter_->state();
+  e.covariance = filter_->covariance();
+  e.rotation_covariance_world = filter_->rotation_covariance_world();
+  e.position_covariance_world = filter_->position_covariance_world();
+  return e;
+}
+
+}  // namespace semap::estimation

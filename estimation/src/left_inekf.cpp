@@ -1,0 +1,250 @@
+#include "semap/estimation/left_inekf.hpp"
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+
+#include "semap/estimation/kalman_update.hpp"
+#include "semap/estimation/so3.hpp"
+
+namespace semap::estimation {
+
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// Orthonormality drifts by ~1e-16 per step; re-projecting every few hundred steps is enough.
+constexpr unsigned kNormaliseEvery = 256;
+
+// 3-point Gauss-Legendre nodes and weights on [0, 1].
+constexpr std::array<double, 3> kNodes = {0.1127016653792583, 0.5, 0.8872983346207417};
+constexpr std::array<double, 3> kWeights = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+
+// Phi = diag(omega) * (Phi_top rows) applied to the 15 x C matrix x; returns rows 0..8.
+template <int C>
+Eigen::Matrix<double, 9, C> phi_top_times(const LeftInekfTransition& b,
+                                          const Eigen::Matrix<double, 15, C>& x) {
+  Eigen::Matrix<double, 9, C> out;
+  const auto x1 = x.template middleRows<3>(kRot);
+  const auto x2 = x.template middleRows<3>(kVel);
+  const auto x3 = x.template middleRows<3>(kPos);
+  const auto x4 = x.template middleRows<3>(kGyroBias);
+  const auto x5 = x.template middleRows<3>(kAccelBias);
+  const Eigen::Matrix<double, 3, C> x23 = b.dt * x2 + x3;
+  out.template middleRows<3>(0).noalias() = b.omega * x1;
+  out.template middleRows<3>(0).noalias() += b.f14 * x4;
+  out.template middleRows<3>(3).noalias() = b.f21 * x1;
+  out.template middleRows<3>(3).noalias() += b.omega * x2;
+  out.template middleRows<3>(3).noalias() += b.f24 * x4;
+  out.template middleRows<3>(3).noalias() += b.f25 * x5;
+  out.template middleRows<3>(6).noalias() = b.f31 * x1;
+  out.template middleRows<3>(6).noalias() += b.omega * x23;
+  out.template middleRows<3>(6).noalias() += b.f34 * x4;
+  out.template middleRows<3>(6).noalias() += b.f35 * x5;
+  return out;
+}
+
+}  // namespace
+
+LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector3d& a,
+                                                 double dt) {
+  LeftInekfTransition b;
+  b.dt = dt;
+  const Vector3d phi = w * dt;
+  const auto c = gamma_coefficients(phi.norm());
+  const Matrix3d k = skew(phi);
+  const Matrix3d k2 = k * k;
+  const Matrix3d g1 = Matrix3d::Identity() + c.a1 * k + c.b1 * k2;
+  const Matrix3d g2 = 0.5 * Matrix3d::Identity() + c.a2 * k + c.b2 * k2;
+  // Gamma0^T = I - a0 K + b0 K^2 (K^T = -K).
+  b.omega = Matrix3d::Identity() - c.a0 * k + c.b0 * k2;
+  const Vector3d u1 = g1 * a * dt;
+  const Vector3d u2 = g2 * a * (dt * dt);
+  b.f21.noalias() = -b.omega * skew(u1);
+  b.f31.noalias() = -b.omega * skew(u2);
+  b.f14 = -dt * g1.transpose();  // omega Gamma1(phi) = Gamma1(-phi) = Gamma1(phi)^T
+  b.f25 = b.f14;
+  b.f35.noalias() = -(dt * dt) * b.omega * g2;
+  // Gyro-bias couplings: Phi_24 = omega int_0^dt [e^{W s} a]x s Gamma1(w s) ds and
+  // Phi_34 = omega int_0^dt (dt - s) [e^{W s} a]x s Gamma1(w s) ds.
+  Matrix3d i24 = Matrix3d::Zero();
+  Matrix3d i34 = Matrix3d::Zero();
+  for (std::size_t n = 0; n < kNodes.size(); ++n) {
+    const double s = kNodes[n] * dt;
+    const Vector3d ps = w * s;
+    const auto cs = gamma_coefficients(ps.norm());
+    const Vector3d pa = ps.cross(a);
+    const Vector3d rot_a = a + cs.a0 * pa + cs.b0 * ps.cross(pa);
+    const Matrix3d ks = skew(ps);
+    const Matrix3d sg1 = s * (Matrix3d::Identity() + cs.a1 * ks + cs.b1 * ks * ks);
+    const Matrix3d g = skew(rot_a) * sg1;
+    i24 += (kWeights[n] * dt) * g;
+    i34 += (kWeights[n] * dt * (dt - s)) * g;
+  }
+  b.f24.noalias() = b.omega * i24;
+  b.f34.noalias() = b.omega * i34;
+  return b;
+}
+
+Matrix15 LeftInekfTransition::dense() const {
+  Matrix15 f = Matrix15::Identity();
+  f.block<3, 3>(kRot, kRot) = omega;
+  f.block<3, 3>(kVel, kVel) = omega;
+  f.block<3, 3>(kPos, kPos) = omega;
+  f.block<3, 3>(kPos, kVel) = dt * omega;
+  f.block<3, 3>(kVel, kRot) = f21;
+  f.block<3, 3>(kPos, kRot) = f31;
+  f.block<3, 3>(kRot, kGyroBias) = f14;
+  f.block<3, 3>(kVel, kGyroBias) = f24;
+  f.block<3, 3>(kVel, kAccelBias) = f25;
+  f.block<3, 3>(kPos, kGyroBias) = f34;
+  f.block<3, 3>(kPos, kAccelBias) = f35;
+  return f;
+}
+
+Eigen::Matrix<double, 15, 1> process_noise_diagonal(const ImuNoise& noise) {
+  Eigen::Matrix<double, 15, 1> q;
+  q.segment<3>(kRot).setConstant(noise.gyro_noise * noise.gyro_noise);
+  q.segment<3>(kVel).setConstant(noise.accel_noise * noise.accel_noise);
+  q.segment<3>(kPos).setConstant(noise.position_process * noise.position_process);
+  q.segment<3>(kGyroBias).setConstant(noise.gyro_bias_walk * noise.gyro_bias_walk);
+  q.segment<3>(kAccelBias).setConstant(noise.accel_bias_walk * noise.accel_bias_walk);
+  return q;
+}
+
+LeftInekf::LeftInekf(const FilterParams& params)
+    : params_(params), q_diag_(process_noise_diagonal(params.noise)) {}
+
+void LeftInekf::reset(const NavState& state, const Matrix15& world_covariance) {
+  r_ = state.rotation;
+  v_ = state.velocity;
+  p_pos_ = state.position;
+  bg_ = state.gyro_bias;
+  ba_ = state.accel_bias;
+  // World-axis errors map to left-invariant ones through R^T on the three group blocks.
+  Matrix15 t = Matrix15::Identity();
+  for (int b = 0; b < 3; ++b) t.block<3, 3>(3 * b, 3 * b) = r_.transpose();
+  p_ = t * world_covariance * t.transpose();
+  steps_since_normalise_ = 0;
+}
+
+void LeftInekf::apply_transition(const LeftInekfTransition& phi) {
+  // Y = Phi P (rows 9..14 of Phi are [0 I]); P- = Phi Y^T, of which only the top-left 9x9
+  // needs new work: the top-right 9x6 is Y's, the bias block is unchanged.
+  const Eigen::Matrix<double, 9, 15> y_top = phi_top_times<15>(phi, p_);
+  const Eigen::Matrix<double, 15, 9> y_top_t = y_top.transpose();
+  const Eigen::Matrix<double, 9, 9> tl = phi_top_times<9>(phi, y_top_t);
+  p_.topLeftCorner<9, 9>() = 0.5 * (tl + tl.transpose());
+  p_.topRightCorner<9, 6>() = y_top.rightCols<6>();
+  p_.bottomLeftCorner<6, 9>() = y_top.rightCols<6>().transpose();
+}
+
+void LeftInekf::propagate(const Vector3d& gyro, const Vector3d& accel, double dt) {
+  const Vector3d w = gyro - bg_;
+  const Vector3d a = accel - ba_;
+  const Vector3d phi = w * dt;
+  const auto c = gamma_coefficients(phi.norm());
+  const Matrix3d k = skew(phi);
+  const Matrix3d k2 = k * k;
+  const Matrix3d g0 = Matrix3d::Identity() + c.a0 * k + c.b0 * k2;
+  const Vector3d ka = k * a;
+  const Vector3d k2a = k * ka;
+  const Vector3d u1 = (a + c.a1 * ka + c.b1 * k2a) * dt;
+  const Vector3d u2 = (0.5 * a + c.a2 * ka + c.b2 * k2a) * (dt * dt);
+
+  // P- = Phi (P + Q dt) Phi^T
+  p_.diagonal() += q_diag_ * dt;
+  apply_transition(LeftInekfTransition::compute(w, a, dt));
+
+  const Vector3d& g = params_.gravity;
+  p_pos_ += v_ * dt + r_ * u2 + (0.5 * dt * dt) * g;
+  v_ += r_ * u1 + dt * g;
+  r_ = r_ * g0;
+  if (++steps_since_normalise_ >= kNormaliseEvery) {
+    r_ = Eigen::Quaterniond(r_).normalized().toRotationMatrix();
+    steps_since_normalise_ = 0;
+  }
+}
+
+void LeftInekf::retract(const Vector15& delta) {
+  // X+ = X exp(delta) on SE_2(3); biases are additive.
+  const Vector3d phi = delta.segment<3>(kRot);
+  const auto c = gamma_coefficients(phi.norm());
+  const Matrix3d k = skew(phi);
+  const Matrix3d k2 = k * k;
+  const Matrix3d g0 = Matrix3d::Identity() + c.a0 * k + c.b0 * k2;
+  const Matrix3d g1 = Matrix3d::Identity() + c.a1 * k + c.b1 * k2;
+  v_ += r_ * (g1 * delta.segment<3>(kVel));
+  p_pos_ += r_ * (g1 * delta.segment<3>(kPos));
+  r_ = r_ * g0;
+  bg_ += delta.segment<3>(kGyroBias);
+  ba_ += delta.segment<3>(kAccelBias);
+}
+
+CorrectionResult LeftInekf::correct_position(const Vector3d& position,
+                                             const Matrix3d& covariance,
+                                             const Vector3d& lever_arm, double gate2) {
+  // Y = X b with b = (lever, 0, 1): innovation X^-1 Y - b = R^T (y - p) - lever, which is
+  // xi_p - [lever]x xi_R to first order, with noise R^T N R.
+  CorrectionResult out;
+  out.residual = position - (p_pos_ + r_ * lever_arm);
+  const Vector3d z = r_.transpose() * out.residual;
+  Matrix3x15 h = Matrix3x15::Zero();
+  h.block<3, 3>(0, kRot) = -skew(lever_arm);
+  h.block<3, 3>(0, kPos).setIdentity();
+  const Matrix3d n = r_.transpose() * covariance * r_;
+  const KalmanUpdate u = joseph_update(p_, z, h, n, gate2);
+  out.accepted = u.accepted;
+  out.mahalanobis2 = u.mahalanobis2;
+  if (u.accepted) retract(u.delta);
+  return out;
+}
+
+CorrectionResult LeftInekf::correct_velocity(const Vector3d& velocity, const Matrix3d& covariance,
+                                             double gate2) {
+  CorrectionResult out;
+  out.residual = velocity - v_;
+  const Vector3d z = r_.transpose() * out.residual;
+  Matrix3x15 h = Matrix3x15::Zero();
+  h.block<3, 3>(0, kVel).setIdentity();
+  const Matrix3d n = r_.transpose() * covariance * r_;
+  const KalmanUpdate u = joseph_update(p_, z, h, n, gate2);
+  out.accepted = u.accepted;
+  out.mahalanobis2 = u.mahalanobis2;
+  if (u.accepted) retract(u.delta);
+  return out;
+}
+
+NavState LeftInekf::state() const {
+  NavState s;
+  s.rotation = r_;
+  s.velocity = v_;
+  s.position = p_pos_;
+  s.gyro_bias = bg_;
+  s.accel_bias = ba_;
+  return s;
+}
+
+Vector15 LeftInekf::error_from(const NavState& truth) const {
+  // xi = log(X_hat^-1 X) on SE_2(3).
+  Vector15 e;
+  const Vector3d phi = so3_log(r_.transpose() * truth.rotation);
+  const Matrix3d j_inv = gamma1_inverse(phi);
+  e.segment<3>(kRot) = phi;
+  e.segment<3>(kVel) = j_inv * (r_.transpose() * (truth.velocity - v_));
+  e.segment<3>(kPos) = j_inv * (r_.transpose() * (truth.position - p_pos_));
+  e.segment<3>(kGyroBias) = truth.gyro_bias - bg_;
+  e.segment<3>(kAccelBias) = truth.accel_bias - ba_;
+  return e;
+}
+
+Eigen::Matrix3d LeftInekf::rotation_covariance_world() const {
+  return r_ * p_.block<3, 3>(kRot, kRot) * r_.transpose();
+}
+
+Eigen::Matrix3d LeftInekf::position_covariance_world() const {
+  return r_ * p_.block<3, 3>(kPos, kPos) * r_.transpose();
+}
+
+}  // namespace semap::estimation

@@ -1,0 +1,95 @@
+#include "semap/estimation/so3.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+
+namespace semap::estimation {
+
+namespace {
+constexpr double kSeriesBelow = 0.1;
+
+Eigen::Matrix3d combine(double c0, double c1, double c2, const Eigen::Vector3d& phi) {
+  const Eigen::Matrix3d k = skew(phi);
+  return c0 * Eigen::Matrix3d::Identity() + c1 * k + c2 * k * k;
+}
+}  // namespace
+
+GammaCoefficients gamma_coefficients(double theta) {
+  GammaCoefficients c{};
+  const double t2 = theta * theta;
+  if (theta < kSeriesBelow) {
+    const double t4 = t2 * t2;
+    const double t6 = t4 * t2;
+    const double sinc = 1.0 - t2 / 6.0 + t4 / 120.0 - t6 / 5040.0;                // sin/t
+    const double cosc = 0.5 - t2 / 24.0 + t4 / 720.0 - t6 / 40320.0;              // (1-cos)/t^2
+    const double sinc3 = 1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 - t6 / 362880.0;    // (t-sin)/t^3
+    const double cosc4 = 1.0 / 24.0 - t2 / 720.0 + t4 / 40320.0 - t6 / 3628800.0;  // (t^2+2cos-2)/(2t^4)
+    c = {sinc, cosc, cosc, sinc3, sinc3, cosc4};
+    return c;
+  }
+  const double s = std::sin(theta);
+  const double co = std::cos(theta);
+  const double t3 = t2 * theta;
+  c.a0 = s / theta;
+  c.b0 = (1.0 - co) / t2;
+  c.a1 = c.b0;
+  c.b1 = (theta - s) / t3;
+  c.a2 = c.b1;
+  c.b2 = (t2 + 2.0 * co - 2.0) / (2.0 * t2 * t2);
+  return c;
+}
+
+Eigen::Matrix3d gamma0(const Eigen::Vector3d& phi) {
+  const auto c = gamma_coefficients(phi.norm());
+  return combine(1.0, c.a0, c.b0, phi);
+}
+
+Eigen::Matrix3d gamma1(const Eigen::Vector3d& phi) {
+  const auto c = gamma_coefficients(phi.norm());
+  return combine(1.0, c.a1, c.b1, phi);
+}
+
+Eigen::Matrix3d gamma2(const Eigen::Vector3d& phi) {
+  const auto c = gamma_coefficients(phi.norm());
+  return combine(0.5, c.a2, c.b2, phi);
+}
+
+Eigen::Matrix3d gamma1_inverse(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  double c2 = 0.0;
+  if (theta < kSeriesBelow) {
+    const double t2 = theta * theta;
+    c2 = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0;
+  } else {
+    c2 = 1.0 / (theta * theta) - (1.0 + std::cos(theta)) / (2.0 * theta * std::sin(theta));
+  }
+  return combine(1.0, -0.5, c2, phi);
+}
+
+Eigen::Vector3d so3_log(const Eigen::Matrix3d& rotation) {
+  // Through the quaternion: stable near 0 and near pi, unlike acos of the trace.
+  Eigen::Quaterniond q(rotation);
+  q.normalize();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  const double vn = q.vec().norm();
+  if (vn < 1e-12) return 2.0 * q.vec() / q.w();
+  const double angle = 2.0 * std::atan2(vn, q.w());
+  return q.vec() * (angle / vn);
+}
+
+double yaw_of(const Eigen::Matrix3d& rotation) { return std::atan2(rotation(1, 0), rotation(0, 0)); }
+
+Eigen::Matrix3d rotation_from_rpy(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+double wrap_angle(double angle) {
+  angle = std::remainder(angle, 2.0 * std::numbers::pi);
+  return angle <= -std::numbers::pi ? angle + 2.0 * std::numbers::pi : angle;
+}
+
+}  // namespace semap::estimation

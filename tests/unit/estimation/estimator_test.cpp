@@ -1,0 +1,288 @@
+#include "semap/estimation/estimator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "semap/estimation/evaluation.hpp"
+#include "semap/estimation/gnss_reorder_buffer.hpp"
+#include "semap/estimation/simulator.hpp"
+#include "semap/estimation/so3.hpp"
+
+namespace semap::estimation {
+namespace {
+
+using common::Stamp;
+using Eigen::Vector3d;
+
+common::ImuSample imu_at(double t, const Vector3d& gyro = Vector3d::Zero(),
+                         const Vector3d& accel = Vector3d(0, 0, 9.80665)) {
+  common::ImuSample s;
+  s.stamp = Stamp::from_seconds(t);
+  s.gyro = gyro;
+  s.accel = accel;
+  return s;
+}
+
+common::GnssFix fix_at(double t, const LocalEnu& enu, const Vector3d& p) {
+  const Geodetic g = enu.to_geodetic(p);
+  common::GnssFix f;
+  f.stamp = Stamp::from_seconds(t);
+  f.latitude_deg = g.latitude_deg;
+  f.longitude_deg = g.longitude_deg;
+  f.altitude_m = g.altitude_m;
+  f.quality = common::FixQuality::kGps;
+  return f;
+}
+
+TEST(ImuValidator, RejectsAndCountsBadSamples) {
+  ImuValidator v(ImuLimits{});
+  double dt = 0.0;
+  EXPECT_EQ(v.check(imu_at(1.0), dt), ImuVerdict::kFirst);
+  EXPECT_EQ(v.check(imu_at(1.01), dt), ImuVerdict::kAccept);
+  EXPECT_NEAR(dt, 0.01, 1e-12);
+  EXPECT_EQ(v.check(imu_at(1.01), dt), ImuVerdict::kNonIncreasing);
+  EXPECT_EQ(v.check(imu_at(1.005), dt), ImuVerdict::kNonIncreasing);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(v.check(imu_at(1.02, Vector3d(nan, 0, 0)), dt), ImuVerdict::kNotFinite);
+  EXPECT_EQ(v.check(imu_at(1.02, Vector3d::Zero(), Vector3d(0, 0, 500.0)), dt),
+            ImuVerdict::kOutOfRange);
+  EXPECT_EQ(v.check(imu_at(1.02, Vector3d(0, 0, 100.0)), dt), ImuVerdict::kOutOfRange);
+  EXPECT_EQ(v.check(imu_at(1.5), dt), ImuVerdict::kGap);
+  EXPECT_EQ(v.check(imu_at(1.51), dt), ImuVerdict::kAccept);
+  const ImuCounters& c = v.counters();
+  EXPECT_EQ(c.accepted, 3u);
+  EXPECT_EQ(c.non_increasing_stamp, 2u);
+  EXPECT_EQ(c.not_finite, 1u);
+  EXPECT_EQ(c.out_of_range, 2u);
+  EXPECT_EQ(c.gap, 1u);
+}
+
+TEST(GnssReorderBuffer, ReleasesInTimeOrderAndRefusesLateFixes) {
+  GnssReorderBuffer b(4);
+  common::GnssFix f;
+  for (double t : {1.3, 1.1, 1.2}) {
+    f.stamp = Stamp::from_seconds(t);
+    EXPECT_TRUE(b.push(f, Stamp::from_seconds(1.0)));
+  }
+  f.stamp = Stamp::from_seconds(1.2);
+  EXPECT_FALSE(b.push(f, Stamp::from_seconds(1.0)));  // duplicate
+  f.stamp = Stamp::from_seconds(0.9);
+  EXPECT_FALSE(b.push(f, Stamp::from_seconds(1.0)));  // older than the filter
+  EXPECT_FALSE(b.pop_until(Stamp::from_seconds(1.05)).has_value());
+  EXPECT_EQ(b.pop_until(Stamp::from_seconds(1.25))->stamp, Stamp::from_seconds(1.1));
+  EXPECT_EQ(b.pop_until(Stamp::from_seconds(1.25))->stamp, Stamp::from_seconds(1.2));
+  EXPECT_FALSE(b.pop_until(Stamp::from_seconds(1.25)).has_value());
+  EXPECT_EQ(b.counters().late, 1u);
+  EXPECT_EQ(b.counters().duplicate, 1u);
+}
+
+TEST(Estimator, InitialisesRollPitchAndGyroBiasFromStaticWindow) {
+  EstimatorConfig config;
+  Estimator e(config);
+  const LocalEnu enu(Geodetic{48.0, 11.0, 500.0});
+  const double roll = 0.05;
+  const double pitch = -0.08;
+  const Eigen::Matrix3d r = rotation_from_rpy(roll, pitch, 0.7);
+  const Vector3d f = r.transpose() * Vector3d(0, 0, 9.80665);
+  const Vector3d bias(0.002, -0.003, 0.001);
+  e.add_gnss(fix_at(1.0, enu, Vector3d::Zero()));
+  for (int k = 0; k <= 150; ++k) e.add_imu(imu_at(1.0 + 0.01 * k, bias, f));
+  ASSERT_TRUE(e.initialised());
+  const auto est = e.estimate();
+  ASSERT_TRUE(est.has_value());
+  const Eigen::Matrix3d re = est->state.rotation;
+  EXPECT_NEAR(std::atan2(re(2, 1), re(2, 2)), roll, 1e-9);
+  EXPECT_NEAR(std::asin(-re(2, 0)), pitch, 1e-9);
+  EXPECT_LT((est->state.gyro_bias - bias).norm(), 1e-12);
+  EXPECT_EQ(e.counters().init_not_static, 0u);
+  ASSERT_TRUE(e.anchor().has_value());
+  EXPECT_NEAR(e.anchor()->latitude_deg, 48.0, 1e-9);
+}
+
+TEST(Estimator, BadInputIsCountedNotFatal) {
+  Estimator e(EstimatorConfig{});
+  common::GnssFix bad;
+  bad.quality = common::FixQuality::kInvalid;
+  e.add_gnss(bad);
+  common::GnssFix nan_fix;
+  nan_fix.quality = common::FixQuality::kGps;
+  nan_fix.latitude_deg = std::numeric_limits<double>::quiet_NaN();
+  e.add_gnss(nan_fix);
+  common::GnssFix bad_cov;
+  bad_cov.quality = common::FixQuality::kGps;
+  bad_cov.covariance = -Eigen::Matrix3d::Identity();
+  e.add_gnss(bad_cov);
+  e.add_imu(imu_at(1.0));
+  e.add_imu(imu_at(0.5));
+  e.add_imu(imu_at(1.01, Vector3d(std::numeric_limits<double>::infinity(), 0, 0)));
+  EXPECT_EQ(e.counters().gnss_invalid, 3u);
+  EXPECT_EQ(e.counters().imu.rejected(), 2u);
+  EXPECT_FALSE(e.initialised());
+  EXPECT_FALSE(e.anchor().has_value());
+}
+
+SimulatorConfig short_drive(double seconds) {
+  SimulatorConfig c;
+  c.duration_s = seconds;
+  c.seed = 11;
+  return c;
+}
+
+EstimatorConfig good_heading(const SimulationData& data) {
+  EstimatorConfig c;
+  c.init.yaw_rad = yaw_of(data.truth.front().state.rotation);
+  c.init.yaw_sigma_rad = 0.05;
+  return c;
+}
+
+double max_position_error_after(const EvaluationRun& run, double t0) {
+  double worst = 0.0;
+  for (const auto& s : run.samples) {
+    if (s.t >= t0) worst = std::max(worst, (s.estimate.position - s.truth.position).norm());
+  }
+  return worst;
+}
+
+TEST(Estimator, GatesATransientFiftyMetreJump) {
+  SimulatorConfig sc = short_drive(90.0);
+  sc.jumps.push_back({60.0, 0.5, Vector3d(50.0, 0.0, 0.0)});
+  const SimulationData data = simulate(sc);
+  const EvaluationRun run = run_evaluation(data, good_heading(data), {});
+  EXPECT_EQ(run.counters.gnss_rejected, 5u);  // the five jumped fixes, nothing else
+  EXPECT_EQ(run.counters.reanchors, 0u);
+  EXPECT_LT(max_position_error_after(run, 30.0), 3.0);
+}
+
+TEST(Estimator, RecoversFromPersistentJumpByReanchoring) {
+  SimulatorConfig sc = short_drive(120.0);
+  sc.jumps.push_back({60.0, 1000.0, Vector3d(50.0, -20.0, 0.0)});
+  const SimulationData data = simulate(sc);
+  const EvaluationRun run = run_evaluation(data, good_heading(data), {});
+  EXPECT_EQ(run.counters.reanchors, 1u);
+  EXPECT_GE(run.counters.gnss_rejected, 10u);
+  EXPECT_LE(run.counters.gnss_rejected, 12u);
+  // Fixes are applied again after the re-anchoring and the estimate never diverged.
+  EXPECT_GT(run.counters.gnss_applied, static_cast<std::uint64_t>(10 * 115));
+  EXPECT_LT(max_position_error_after(run, 30.0), 3.0);
+}
+
+TEST(Estimator, LateFixesAreAppliedInOrderWithinTheImuDelay) {
+  const SimulationData data = simulate(short_drive(40.0));
+  EstimatorConfig config = good_heading(data);
+  config.anchor = data.origin;
+  config.imu_delay_s = 0.2;  // swapped pairs arrive up to 0.15 s late
+  Estimator e(config);
+  // Each fix arrives 50 ms after its stamp, and pairs arrive swapped.
+  std::vector<std::pair<Stamp, common::GnssFix>> arrivals;
+  for (std::size_t i = 0; i < data.gnss.size(); ++i) {
+    const std::size_t j = (i % 2 == 0 && i + 1 < data.gnss.size()) ? i + 1 : (i % 2 ? i - 1 : i);
+    arrivals.push_back({data.gnss[i].stamp + 0.05, data.gnss[j]});
+  }
+  std::size_t g = 0;
+  for (const auto& imu : data.imu) {
+    while (g < arrivals.size() && arrivals[g].first <= imu.stamp) e.add_gnss(arrivals[g++].second);
+    e.add_imu(imu);
+  }
+  const auto& c = e.counters();
+  EXPECT_EQ(c.gnss_buffer.late, 0u);
+  EXPECT_GT(c.gnss_applied, data.gnss.size() - 25);
+  const auto est = e.estimate();
+  ASSERT_TRUE(est.has_value());
+  EXPECT_LT((est->state.position - data.truth.back().state.position).norm(), 10.0);
+
+  // Without the delay the same arrivals are late and refused, never applied out of order.
+  config.imu_delay_s = 0.0;
+  Estimator immediate(config);
+  g = 0;
+  for (const auto& imu : data.imu) {
+    while (g < arrivals.size() && arrivals[g].first <= imu.stamp) {
+      immediate.add_gnss(arrivals[g++].second);
+    }
+    immediate.add_imu(imu);
+  }
+  EXPECT_GT(immediate.counters().gnss_buffer.late, data.gnss.size() / 3);
+}
+
+TEST(Estimator, EstimatesStaticBiases) {
+  SimulatorConfig sc;
+  sc.duration_s = 120.0;
+  sc.speed_m_s = 0.0;
+  sc.static_s = 1000.0;
+  sc.initial_gyro_bias_sigma = 0.01;
+  sc.initial_accel_bias_sigma = 0.1;
+  sc.gnss_velocity = true;
+  sc.seed = 5;
+  const SimulationData data = simulate(sc);
+  EstimatorConfig config = good_heading(data);
+  config.use_gnss_velocity = true;  // at rest, position-only GNSS lets tilt and yaw wander
+  config.anchor = data.origin;
+  Estimator e(config);
+  std::size_t g = 0;
+  for (const auto& imu : data.imu) {
+    while (g < data.gnss.size() && data.gnss[g].stamp <= imu.stamp) e.add_gnss(data.gnss[g++]);
+    e.add_imu(imu);
+  }
+  const auto est = e.estimate();
+  ASSERT_TRUE(est.has_value());
+  const NavState& truth = data.truth.back().state;
+  const Vector15 err = e.filter().error_from(truth);
+  const Vector15 sigma = est->covariance.diagonal().cwiseSqrt();
+  // Gyro biases (x, y through tilt; z from the static window) and the vertical accelerometer
+  // bias are estimated to well below their initial uncertainty, and consistently (4 sigma).
+  for (int i : {kGyroBias, kGyroBias + 1, kGyroBias + 2, kAccelBias + 2}) {
+    EXPECT_LT(std::abs(err(i)), 4.0 * sigma(i)) << "component " << i;
+  }
+  EXPECT_LT(sigma(kGyroBias), 1e-3);
+  EXPECT_LT(sigma(kGyroBias + 1), 1e-3);
+  EXPECT_LT(sigma(kAccelBias + 2), 0.02);
+  EXPECT_LT(std::abs(err(kGyroBias)), 5e-4);
+  EXPECT_LT(std::abs(err(kAccelBias + 2)), 0.03);
+  EXPECT_GT(std::abs(truth.accel_bias.z()), 0.0);
+  EXPECT_GT(e.counters().velocity_applied, 1000u);
+  EXPECT_EQ(e.counters().init_not_static, 0u);
+}
+
+TEST(Estimator, InterpolatesPoseFromHistory) {
+  const SimulationData data = simulate(short_drive(20.0));
+  EstimatorConfig config = good_heading(data);
+  config.anchor = data.origin;
+  Estimator e(config);
+  std::size_t g = 0;
+  for (const auto& imu : data.imu) {
+    while (g < data.gnss.size() && data.gnss[g].stamp <= imu.stamp) e.add_gnss(data.gnss[g++]);
+    e.add_imu(imu);
+  }
+  const Stamp a = data.imu[1500].stamp;
+  const Stamp b = data.imu[1501].stamp;
+  const auto pa = e.pose_at(a);
+  const auto pb = e.pose_at(b);
+  const auto mid = e.pose_at(Stamp((a.ns + b.ns) / 2));
+  ASSERT_TRUE(pa && pb && mid);
+  EXPECT_LT((mid->position - 0.5 * (pa->position + pb->position)).norm(), 1e-9);
+  EXPECT_LT(mid->orientation.angularDistance(pa->orientation), 
+            pa->orientation.angularDistance(pb->orientation) + 1e-12);
+  EXPECT_FALSE(e.pose_at(data.imu.back().stamp + 1.0).has_value());
+  EXPECT_FALSE(e.pose_at(data.imu.front().stamp).has_value());  // older than the history
+}
+
+TEST(EstimatorConfig, LoadsAndRejectsUnknownKeys) {
+  const auto ok = common::ConfigSection::load_string(
+      "filter: eskf\ngating_probability: 0.99\nlever_arm: [0, 0, 1.2]\ninit_yaw_deg: 90\n"
+      "anchor: [49.0, 8.4, 110]\n");
+  const EstimatorConfig c = load_estimator_config(ok);
+  EXPECT_EQ(c.filter, FilterKind::kQuaternionEskf);
+  EXPECT_DOUBLE_EQ(c.gating_probability, 0.99);
+  EXPECT_DOUBLE_EQ(c.lever_arm.z(), 1.2);
+  EXPECT_NEAR(c.init.yaw_rad, M_PI / 2, 1e-12);
+  ASSERT_TRUE(c.anchor.has_value());
+  EXPECT_DOUBLE_EQ(c.anchor->longitude_deg, 8.4);
+  const auto typo = common::ConfigSection::load_string("gating_probabilty: 0.99\n");
+  EXPECT_THROW(load_estimator_config(typo), common::ConfigError);
+  const auto range = common::ConfigSection::load_string("gating_probability: 1.5\n");
+  EXPECT_THROW(load_estimator_config(range), common::ConfigError);
+}
+
+}  // namespace
+}  // namespace semap::estimation

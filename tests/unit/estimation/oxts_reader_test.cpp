@@ -1,0 +1,94 @@
+#include "semap/estimation/oxts_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "semap/estimation/so3.hpp"
+
+namespace semap::estimation {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A line in the KITTI format: lat lon alt roll pitch yaw vn ve vf vl vu ax ay az af al au
+// wx wy wz wf wl wu pos_accuracy vel_accuracy navstat numsats posmode velmode orimode.
+std::string line(double lat, double lon, double yaw, double ve) {
+  std::ostringstream s;
+  s.precision(12);
+  s << lat << ' ' << lon << " 112.5 0.01 -0.02 " << yaw << " 0.5 " << ve
+    << " 8.0 0.1 0.05 0.3 -0.1 9.81 0.3 -0.1 9.81 0.001 0.002 0.05 0.001 0.002 0.05 "
+    << "0.4 0.05 4 11 5 5 6";
+  return s.str();
+}
+
+class OxtsFolder : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("semap_oxts_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "data");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+  }
+  fs::path dir_;
+};
+
+TEST_F(OxtsFolder, ReadsRecordsAndReportsBadOnes) {
+  write("timestamps.txt",
+        "2011-09-26 13:02:25.964389445\n2011-09-26 13:02:26.074380937\n"
+        "2011-09-26 13:02:26.184372000\n2011-09-26 13:02:26.294363000\n");
+  write("data/0000000000.txt", line(49.015, 8.43, 1.2, 8.0) + "\n");
+  write("data/0000000001.txt", line(49.01501, 8.43001, 1.21, 8.1) + "\n");
+  write("data/0000000002.txt", "49.0 8.4 112.0 0.0 oops\n");
+  write("data/0000000003.txt", line(49.01502, 8.43002, 1.22, 8.2) + "\n");
+  const OxtsData d = read_oxts_folder(dir_);
+  ASSERT_EQ(d.records.size(), 3u);
+  ASSERT_EQ(d.errors.size(), 1u);
+  EXPECT_NE(d.errors[0].find("0000000002.txt:1"), std::string::npos) << d.errors[0];
+  EXPECT_NE(d.errors[0].find("field 5 (pitch)"), std::string::npos) << d.errors[0];
+  const OxtsRecord& r = d.records[1];
+  EXPECT_DOUBLE_EQ(r.latitude_deg, 49.01501);
+  EXPECT_DOUBLE_EQ(r.yaw, 1.21);
+  EXPECT_DOUBLE_EQ(r.velocity_enu.x(), 8.1);  // ve
+  EXPECT_DOUBLE_EQ(r.velocity_enu.y(), 0.5);  // vn
+  EXPECT_DOUBLE_EQ(r.accel.z(), 9.81);
+  EXPECT_DOUBLE_EQ(r.gyro.z(), 0.05);
+  EXPECT_EQ(r.satellites, 11);
+  EXPECT_EQ(r.stamp.ns - d.records[0].stamp.ns, 109991492);
+
+  const SimulationData in = oxts_to_inputs(d, 0.5, 1);
+  ASSERT_EQ(in.imu.size(), 3u);
+  ASSERT_EQ(in.gnss.size(), 3u);
+  EXPECT_NEAR(in.origin.latitude_deg, 49.015, 1e-12);
+  EXPECT_LT(in.truth[0].state.position.norm(), 1e-9);
+  EXPECT_NEAR(in.truth[1].state.position.y(), 0.00001 * 111200.0, 0.5);  // ~1.1 m north
+  EXPECT_NEAR(yaw_of(in.truth[2].state.rotation), 1.22, 1e-9);
+}
+
+TEST_F(OxtsFolder, MissingFolderThrows) {
+  EXPECT_THROW(read_oxts_folder(dir_ / "nope"), std::runtime_error);
+}
+
+TEST(OxtsParser, RejectsMalformedLinesWithField) {
+  std::string error;
+  EXPECT_FALSE(parse_oxts_line("1 2 3", error).has_value());
+  EXPECT_NE(error.find("got 3"), std::string::npos);
+  EXPECT_FALSE(parse_oxts_line(line(49, 8, 0, 0) + " 7", error).has_value());
+  EXPECT_FALSE(parse_oxts_line(line(95, 8, 0, 0), error).has_value());
+  EXPECT_FALSE(parse_oxts_line("nan" + line(49, 8, 0, 0).substr(2), error).has_value());
+  EXPECT_TRUE(parse_oxts_line(line(49, 8, 0, 0) + "\r\n", error).has_value());
+  EXPECT_FALSE(parse_kitti_timestamp("2011-09-26T13:02:25").has_value());
+  EXPECT_FALSE(parse_kitti_timestamp("2011-13-26 13:02:25.1").has_value());
+  const auto t = parse_kitti_timestamp("1970-01-01 00:00:01.5");
+  ASSERT_TRUE(t.has_value());
+  EXPECT_EQ(t->ns, 1'500'000'000);
+}
+
+}  // namespace
+}  // namespace semap::estimation
