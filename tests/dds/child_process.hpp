@@ -21,7 +21,20 @@ namespace semap::dds_idl::testing {
 // inherits the environment, so CYCLONEDDS_URI set by ctest reaches it too. Killed on scope exit.
 class ChildProcess {
  public:
-  explicit ChildProcess(const std::vector<std::string>& argv) {
+  // `env` entries ("NAME=value") are added to, or replace, the inherited environment.
+  explicit ChildProcess(const std::vector<std::string>& argv,
+                        const std::vector<std::string>& env = {}) {
+    std::vector<std::string> environment = env;
+    for (char** e = environ; *e; ++e) {
+      const std::string entry(*e);
+      const std::string name = entry.substr(0, entry.find('='));
+      bool overridden = false;
+      for (const auto& x : env) overridden = overridden || x.rfind(name + "=", 0) == 0;
+      if (!overridden) environment.push_back(entry);
+    }
+    std::vector<char*> envp;
+    for (auto& x : environment) envp.push_back(x.data());
+    envp.push_back(nullptr);
     int fds[2];
     if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe2 failed");
     posix_spawn_file_actions_t actions;
@@ -30,7 +43,7 @@ class ChildProcess {
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
-    const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+    const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), envp.data());
     posix_spawn_file_actions_destroy(&actions);
     close(fds[1]);
     if (rc != 0) {

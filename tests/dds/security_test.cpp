@@ -120,5 +120,25 @@ TEST_F(SecurityTest, OnlyTheRobotMayWriteAndUnlistedIdentitiesMayNotJoin) {
   EXPECT_THROW(Participant(test_domain(), identity("intruder")), DdsError);
 }
 
+// Processes that cannot set security QoS (ros2 CLI, ddsperf) use config/cyclonedds-secure.xml
+// with the identity in environment variables; the rights are the same.
+TEST_F(SecurityTest, SecuredXmlConfigurationGivesTheSameRights) {
+  const std::string ns = unique_ns("secure_xml");
+  ChildProcess robot(secured_peer("pose-pub", "robot", {"--ns", ns, "--seconds", "20"}));
+  ASSERT_TRUE(robot.expect("writer ok", seconds(10)));
+  const auto env = [](const std::string& who) {
+    return std::vector<std::string>{
+        "CYCLONEDDS_URI=file://" + std::string(SEMAP_SOURCE_DIR) + "/config/cyclonedds-secure.xml",
+        "SEMAP_DDS_SECURITY_DIR=" + dir_.string(), "SEMAP_DDS_IDENTITY=" + who,
+        "SEMAP_DDS_SECURITY_PLUGINS=" + std::string(SEMAP_DDS_SECURITY_PLUGIN_DIR)};
+  };
+  ChildProcess planner(peer("pose-listen", {"--ns", ns, "--seconds", "2"}), env("planner"));
+  ChildProcess intruder(peer("pose-listen", {"--ns", ns, "--seconds", "2"}), env("intruder"));
+  const auto received = planner.expect("received", seconds(10));
+  ASSERT_TRUE(received);
+  EXPECT_NE(*received, "received 0");
+  EXPECT_TRUE(intruder.expect("error: dds_create_participant", seconds(10)));
+}
+
 }  // namespace
 }  // namespace semap::dds_idl::testing
