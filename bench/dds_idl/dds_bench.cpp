@@ -1,7 +1,7 @@
 // dds_bench: map blocks from a MapPublisher to a reader in another process over loopback.
 // Prints blocks/s and MB/s at two block sizes, publish-to-receive latency p50/p99 at 10 Hz map
 // updates, and ddsperf's rate for the same payload sizes in the same run.
-//   dds_bench [seconds]          (default 3 s a throughput run)
+//   dds_bench [seconds [repetitions]]   (default 3 s a throughput run, median of 3)
 // The reader is this binary again (`dds_bench --reader ...`). CYCLONEDDS_URI defaults to the
 // loopback XML of the source tree, so nothing leaves 127.0.0.1.
 #include <algorithm>
@@ -255,26 +255,40 @@ int main(int argc, char** argv) {
       return run_reader(std::atoi(argv[2]), argv[3], std::strcmp(argv[4], "1") == 0);
     }
     const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
+    const int reps = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
     std::random_device rd;
     const int domain = 1 + static_cast<int>(rd() % 200);
-    std::printf("dds_bench: domain %d, CYCLONEDDS_URI=%s, %.0f s a run\n", domain,
-                std::getenv("CYCLONEDDS_URI"), seconds);
+    std::printf("dds_bench: domain %d, CYCLONEDDS_URI=%s, %.0f s a run, median of %d\n", domain,
+                std::getenv("CYCLONEDDS_URI"), seconds, reps);
     // ddsperf twice: its default (reliable keep-all, one key: the baseline) and with
     // our map QoS (keep-last 1 over 1000 keys), which cannot throttle the writer.
     std::printf("%-22s %10s %8s %10s %14s %6s %16s %6s\n", "map blocks (no evid.)", "blocks/s",
                 "MB/s", "written/s", "ddsperf dflt/s", "ratio", "ddsperf k1 n1000", "ratio");
+    // Interleaved repetitions, medians reported: load from other processes comes and goes.
+    const auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
     for (std::uint16_t cells : {5, 8}) {
       const std::size_t bytes = block_bytes(cells);
-      const Throughput t = throughput(domain, cells, seconds);
-      const double ref = ddsperf_rate(domain, bytes, seconds, "");
-      const double ref_k1 = ddsperf_rate(domain, bytes, seconds, " -k 1 -n 1000");
+      std::vector<double> ours, mbs, written, ref, ref_k1;
+      std::uint64_t bad = 0;
+      for (int rep = 0; rep < reps; ++rep) {
+        const Throughput t = throughput(domain, cells, seconds);
+        ours.push_back(t.blocks_per_s);
+        mbs.push_back(t.mb_per_s);
+        written.push_back(t.written_per_s);
+        bad += t.bad;
+        ref.push_back(ddsperf_rate(domain, bytes, seconds, ""));
+        ref_k1.push_back(ddsperf_rate(domain, bytes, seconds, " -k 1 -n 1000"));
+      }
+      const double o = median(ours), r = median(ref), r1 = median(ref_k1);
       char label[64];
       std::snprintf(label, sizeof label, "%u^3 cells, %zu B", cells, bytes);
-      std::printf("%-22s %10.0f %8.1f %10.0f %14.0f %5.0f%% %16.0f %5.0f%%%s\n", label,
-                  t.blocks_per_s, t.mb_per_s, t.written_per_s, ref,
-                  ref > 0 ? 100.0 * t.blocks_per_s / ref : 0.0, ref_k1,
-                  ref_k1 > 0 ? 100.0 * t.blocks_per_s / ref_k1 : 0.0,
-                  t.bad ? " (INVALID BLOCKS RECEIVED)" : "");
+      std::printf("%-22s %10.0f %8.1f %10.0f %14.0f %5.0f%% %16.0f %5.0f%%%s\n", label, o,
+                  median(mbs), median(written), r, r > 0 ? 100.0 * o / r : 0.0, r1,
+                  r1 > 0 ? 100.0 * o / r1 : 0.0, bad ? " (INVALID BLOCKS RECEIVED)" : "");
+      std::fflush(stdout);
     }
     for (int per_update : {10, 100}) {
       const Latency l = latency(domain, 8, per_update, std::max(3.0, seconds));
