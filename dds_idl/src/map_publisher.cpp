@@ -66,12 +66,18 @@ std::size_t MapPublisher::spin_once(common::Stamp now) {
 std::size_t MapPublisher::publish_changed(common::Stamp now) {
   if (info_dirty_) publish_info(now);
   std::size_t written = 0;
-  for (const BlockIndex& index : changed_) {
-    const BlockMessage m(blocks_.at(index), now, config_.frame_id);
-    block_writer_.write(m.get());
+  for (auto it = changed_.begin(); it != changed_.end();) {
+    const BlockMessage m(blocks_.at(*it), now, config_.frame_id);
+    try {
+      block_writer_.write(m.get());
+    } catch (const DdsError& e) {
+      if (e.code() != DDS_RETCODE_TIMEOUT) throw;
+      ++counters_.write_timeouts;
+      break;
+    }
+    it = changed_.erase(it);
     ++written;
   }
-  changed_.clear();
   counters_.blocks_written += written;
   if (written > 0) ++counters_.block_publications;
   return written;

@@ -9,6 +9,7 @@
 
 #include "semap/dds_idl/block_codec.hpp"
 #include "semap/dds_idl/converters.hpp"
+#include "semap/dds_idl/health.hpp"
 #include "semap/dds_idl/map_client.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/dds_idl/topic_names.hpp"
@@ -175,10 +176,9 @@ int types_pub(const Options& o, const sd::Participant& p) {
   pose.position = {1.0, 2.0, 3.0};
   pose.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
   pose.velocity_body = {0.5, 0.0, 0.0};
-  std::string stage_name = "mapping";
-  std::string driver_name = "can_imu";
-  semap_msgs_msg_dds__StageHealth_ stage{stage_name.data(), 9.5f, 3, 2, 1.5f, 4.0f};
-  semap_msgs_msg_dds__DriverCounters_ driver{driver_name.data(), 4000, 1, 0, 0};
+  sd::HealthReport report;
+  report.stages.push_back({"mapping", 9.5f, 3, 2, 1.5f, 4.0f});
+  report.drivers.push_back({"can_imu", 4000, 1, 0, 0});
 
   const auto start = std::chrono::steady_clock::now();
   std::uint64_t n = 0;
@@ -197,13 +197,9 @@ int types_pub(const Options& o, const sd::Participant& p) {
     sd::msg::PoseWithCovarianceStamped pose_m;
     sd::to_msg(pose, frame, pose_m);
     pose_w.write(pose_m);
-    sd::msg::Health health{};
-    health.header_.stamp_ = sd::to_msg_time(now);
-    health.header_.frame_id_ = const_cast<char*>(base.c_str());
-    health.stages_ = sd::borrow_sequence<dds_sequence_semap_msgs_msg_dds__StageHealth_>(&stage, 1);
-    health.drivers_ =
-        sd::borrow_sequence<dds_sequence_semap_msgs_msg_dds__DriverCounters_>(&driver, 1);
-    health_w.write(health);
+    report.stamp = now;
+    const sd::HealthMessage health(report, base);
+    health_w.write(health.get());
     map.spin_once(now);
     if (++n == 1) std::cout << "publishing" << std::endl;
     std::this_thread::sleep_for(milliseconds(50));

@@ -3,6 +3,7 @@
 
 #include "dds_fixture.hpp"
 #include "semap/dds_idl/converters.hpp"
+#include "semap/dds_idl/health.hpp"
 #include "semap/dds_idl/map_cloud.hpp"
 #include "semap/dds_idl/reader.hpp"
 #include "semap/dds_idl/topic_names.hpp"
@@ -74,17 +75,20 @@ TEST_F(DdsTest, PublisherAndListenerExchangeEveryType) {
   ASSERT_TRUE(pose);
   EXPECT_TRUE(pose->position.isApprox(Eigen::Vector3d(1.0, 2.0, 3.0)));
 
-  const auto health =
-      first_sample<msg::Health>(p, ns, SemapTopic::kHealth, [](const msg::Health& m) {
-        EXPECT_EQ(m.stages_._length, 1u);
-        EXPECT_EQ(m.drivers_._length, 1u);
-        return std::make_tuple(std::string(m.stages_._buffer[0].name_),
-                               m.stages_._buffer[0].rate_hz_, m.drivers_._buffer[0].frames_);
-      });
+  const auto health = first_sample<msg::Health>(p, ns, SemapTopic::kHealth,
+                                                [](const msg::Health& m) { return from_msg(m); });
   ASSERT_TRUE(health);
-  EXPECT_EQ(std::get<0>(*health), "mapping");
-  EXPECT_FLOAT_EQ(std::get<1>(*health), 9.5f);
-  EXPECT_EQ(std::get<2>(*health), 4000u);
+  ASSERT_EQ(health->stages.size(), 1u);
+  ASSERT_EQ(health->drivers.size(), 1u);
+  EXPECT_EQ(health->stages[0].name, "mapping");
+  EXPECT_FLOAT_EQ(health->stages[0].rate_hz, 9.5f);
+  EXPECT_EQ(health->stages[0].queue_depth, 3u);
+  EXPECT_EQ(health->stages[0].drops, 2u);
+  EXPECT_FLOAT_EQ(health->stages[0].latency_p99_ms, 4.0f);
+  EXPECT_EQ(health->drivers[0].name, "can_imu");
+  EXPECT_EQ(health->drivers[0].frames, 4000u);
+  EXPECT_EQ(health->drivers[0].bad_frames, 1u);
+  EXPECT_GT(health->stamp.ns, 0);
 
   const auto cloud = first_sample<msg::PointCloud2>(
       p, ns, SemapTopic::kMapCloud, [](const msg::PointCloud2& m) { return read_map_cloud(m); });

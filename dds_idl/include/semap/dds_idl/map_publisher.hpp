@@ -26,6 +26,9 @@ struct MapPublisherCounters {
   std::uint64_t block_publications = 0;  // rounds with at least one changed block
   std::uint64_t clouds_written = 0;
   std::uint64_t infos_written = 0;
+  // Rounds cut short because a reliable reader did not keep up within the blocking time; the
+  // unsent blocks stay pending for the next round.
+  std::uint64_t write_timeouts = 0;
 };
 
 // The mapping side of the map topics. The mapping stage hands over changed blocks with
@@ -41,7 +44,8 @@ class MapPublisher {
   void update(BlockSnapshot block);
   // Writes what is due at `now`; returns the number of blocks written.
   std::size_t spin_once(common::Stamp now);
-  // Writes all pending blocks now, regardless of the rate.
+  // Writes all pending blocks now, regardless of the rate. A write timeout ends the round
+  // early (counted); other DDS failures throw DdsError.
   std::size_t publish_changed(common::Stamp now);
   void publish_cloud(common::Stamp now);
 
