@@ -1,0 +1,95 @@
+// semap-map-listener: follows one robot's map (and pose) over DDS, prints what arrives and can
+// save the received map.
+#include <chrono>
+#include <iostream>
+#include <thread>
+
+#include "dds_app.hpp"
+#include "semap/common/logging.hpp"
+#include "semap/dds_idl/converters.hpp"
+#include "semap/dds_idl/map_client.hpp"
+#include "semap/dds_idl/topic_names.hpp"
+
+namespace sd = semap::dds_idl;
+
+int main(int argc, char** argv) {
+  CLI::App app("Prints the semantic map and pose a robot publishes over DDS");
+  semap::apps::DdsOptions dds;
+  dds.add_flags(app);
+  std::string config_path;
+  std::string save_path;
+  double seconds = 0.0;
+  std::size_t expect_blocks = 0;
+  int num_classes = 0;
+  app.add_option("--config", config_path, "semap YAML; its dds: section is used")
+      ->check(CLI::ExistingFile);
+  app.add_option("--save", save_path, "write the received map as PCD (x y z class variance)");
+  app.add_option("--seconds", seconds, "stop after this long (0: until Ctrl-C)");
+  app.add_option("--expect-blocks", expect_blocks, "stop once this many blocks arrived");
+  app.add_option("--classes", num_classes, "reject blocks with another class count");
+  CLI11_PARSE(app, argc, argv);
+  semap::common::setup_logging();
+
+  try {
+    if (!config_path.empty()) {
+      const auto root = semap::common::ConfigSection::load_file(config_path);
+      dds.read(root.section("dds"), app);
+    }
+    semap::apps::install_stop_handlers();
+    const sd::Participant participant = dds.participant();
+    sd::MapClientConfig cfg;
+    cfg.ns = dds.ns;
+    cfg.limits.num_classes = static_cast<std::uint16_t>(num_classes);
+    sd::MapClient client(participant, cfg);
+    sd::Topic<sd::msg::Odometry> odom_topic(participant,
+                                            sd::topic_name(dds.ns, sd::SemapTopic::kOdometry));
+    sd::Reader<sd::msg::Odometry> odom(participant, odom_topic,
+                                       sd::topic_qos(sd::SemapTopic::kOdometry));
+
+    std::cout << "listening on " << sd::topic_name(dds.ns, sd::SemapTopic::kMapBlocks)
+              << " (domain " << dds.domain << ")" << std::endl;
+    const auto start = std::chrono::steady_clock::now();
+    auto next_report = start;
+    std::uint64_t info_seen = 0;
+    std::optional<sd::PoseEstimate> last_pose;
+    while (!semap::apps::stop_requested()) {
+      client.wait_for_blocks(SIZE_MAX, std::chrono::milliseconds(100));
+      odom.take_each([&](const sd::msg::Odometry& m, const dds_sample_info_t&) {
+        last_pose = sd::from_msg(m);
+      });
+      const auto now = std::chrono::steady_clock::now();
+      if (client.counters().infos != info_seen && client.info()) {
+        info_seen = client.counters().infos;
+        const auto& i = *client.info();
+        std::cout << "map_info: resolution " << i.resolution << " m, " << i.block_cells
+                  << "^3 cells/block, " << i.num_classes << " classes, " << i.num_blocks
+                  << " blocks, sequence " << i.sequence << std::endl;
+      }
+      if (now >= next_report) {
+        const auto& c = client.counters();
+        std::cout << "blocks " << client.blocks().size() << " accepted " << c.accepted
+                  << " rejected " << c.rejected_total() << " stale " << c.stale;
+        if (last_pose) {
+          std::cout << " pose " << last_pose->position.transpose();
+        }
+        std::cout << std::endl;
+        if (c.rejected_total() > 0)
+          std::cout << "  last error: " << client.last_error() << std::endl;
+        next_report = now + std::chrono::seconds(1);
+      }
+      if (expect_blocks > 0 && client.blocks().size() >= expect_blocks) break;
+      if (seconds > 0 && now - start > std::chrono::duration<double>(seconds)) break;
+    }
+    std::cout << "final: blocks " << client.blocks().size() << " accepted "
+              << client.counters().accepted << " rejected " << client.counters().rejected_total()
+              << std::endl;
+    if (!save_path.empty()) {
+      client.save_pcd(save_path);
+      std::cout << "saved " << save_path << std::endl;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "semap-map-listener: " << e.what() << std::endl;
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,305 @@
+// dds_bench: map blocks from a MapPublisher to a reader in another process over loopback.
+// Prints blocks/s and MB/s at two block sizes, publish-to-receive latency p50/p99 at 10 Hz map
+// updates, and ddsperf's rate for the same payload sizes in the same run.
+//   dds_bench [seconds [repetitions]]   (default 3 s a throughput run, median of 3)
+// The reader is this binary again (`dds_bench --reader ...`). CYCLONEDDS_URI defaults to the
+// loopback XML of the source tree, so nothing leaves 127.0.0.1.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "semap/dds_idl/block_codec.hpp"
+#include "semap/dds_idl/converters.hpp"
+#include "semap/dds_idl/map_publisher.hpp"
+#include "semap/dds_idl/topic_names.hpp"
+
+namespace sd = semap::dds_idl;
+using semap::common::Stamp;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr std::uint16_t kClasses = 8;
+
+// Serialized size of a block without evidence (XCDR1): header, key, shape, four sequences.
+std::size_t block_bytes(std::uint16_t cells) {
+  const std::size_t n = static_cast<std::size_t>(cells) * cells * cells;
+  std::size_t s = 8 + 4 + 4;            // stamp, frame_id "map"
+  s += 12 + 4 + 2 + 2 + 4;              // key, resolution, shape, version
+  s += 4 + n;                           // state
+  s = (s + 3) / 4 * 4 + 4 + 2 * n;      // argmax_class (aligned length)
+  s = (s + 3) / 4 * 4 + 4 + 4 * n + 4;  // variance, empty evidence
+  return s;
+}
+
+struct Pipe {
+  std::FILE* f = nullptr;
+  explicit Pipe(const std::string& cmd) : f(popen(cmd.c_str(), "r")) {
+    if (!f) throw std::runtime_error("popen " + cmd);
+  }
+  ~Pipe() {
+    if (f) pclose(f);
+  }
+  bool line(std::string& out) {
+    char buf[1024];
+    if (!std::fgets(buf, sizeof buf, f)) return false;
+    out = buf;
+    return true;
+  }
+  std::string expect(const std::string& prefix) {
+    std::string l;
+    while (line(l)) {
+      if (l.rfind(prefix, 0) == 0) return l;
+    }
+    throw std::runtime_error("child ended before '" + prefix + "'");
+  }
+};
+
+// ---- reader side (child process) ----
+
+int run_reader(int domain, const std::string& ns, bool latency) {
+  sd::Participant p(domain);
+  sd::Topic<sd::msg::SemanticMapBlock> topic(p, sd::topic_name(ns, sd::SemapTopic::kMapBlocks));
+  sd::Reader<sd::msg::SemanticMapBlock> reader(p, topic, sd::topic_qos(sd::SemapTopic::kMapBlocks));
+  while (reader.matched() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  std::cout << "ready" << std::endl;
+  std::uint64_t n = 0, bad = 0, bytes = 0;
+  Clock::time_point first, last;
+  std::vector<double> latencies_us;
+  const sd::BlockLimits limits;
+  for (;;) {
+    const bool got = reader.wait(std::chrono::milliseconds(n == 0 ? 20000 : 1500));
+    if (!got) break;
+    reader.take_each([&](const sd::msg::SemanticMapBlock& m, const dds_sample_info_t&) {
+      const Stamp now = Stamp::now();
+      // Validation and copy as the MapClient does them, so the figure is our stack's.
+      const sd::DecodedBlock d = sd::decode_block(m, limits);
+      if (!d.block) ++bad;
+      if (n == 0) first = Clock::now();
+      last = Clock::now();
+      ++n;
+      bytes += block_bytes(m.block_cells_);
+      if (latency) {
+        latencies_us.push_back(
+            static_cast<double>(now.ns - sd::from_msg_time(m.header_.stamp_).ns) * 1e-3);
+      }
+    });
+  }
+  const double secs = std::chrono::duration<double>(last - first).count();
+  std::cout << "result " << n << " " << bytes << " " << secs << " " << bad;
+  if (latency && !latencies_us.empty()) {
+    std::sort(latencies_us.begin(), latencies_us.end());
+    const auto pct = [&](double q) {
+      return latencies_us[std::min(
+          latencies_us.size() - 1,
+          static_cast<std::size_t>(q * static_cast<double>(latencies_us.size())))];
+    };
+    std::cout << " " << pct(0.5) << " " << pct(0.99) << " " << latencies_us.back();
+  }
+  std::cout << std::endl;
+  return 0;
+}
+
+// ---- writer side ----
+
+sd::MapDescription description(std::uint16_t cells) {
+  sd::MapDescription d;
+  d.resolution = 0.1f;
+  d.block_cells = cells;
+  d.num_classes = kClasses;
+  return d;
+}
+
+sd::BlockSnapshot block(sd::BlockIndex index, std::uint16_t cells, std::uint32_t version) {
+  sd::BlockSnapshot b = sd::BlockSnapshot::empty(index, 0.1f, cells, kClasses, false);
+  b.version = version;
+  for (std::size_t i = 0; i < b.cell_count(); ++i) {
+    b.state[i] = static_cast<sd::CellState>(i % 3);
+    b.argmax_class[i] = static_cast<std::uint16_t>(i % kClasses);
+    b.variance[i] = 0.01f;
+  }
+  return b;
+}
+
+std::string self_path() {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) throw std::runtime_error("readlink /proc/self/exe");
+  return std::string(buf, static_cast<std::size_t>(n));
+}
+
+struct Throughput {
+  double blocks_per_s = 0;
+  double mb_per_s = 0;
+  double written_per_s = 0;
+  std::uint64_t received = 0;
+  std::uint64_t bad = 0;
+};
+
+Throughput throughput(int domain, std::uint16_t cells, double seconds) {
+  const std::string ns = "bench_tp" + std::to_string(cells);
+  Pipe reader(self_path() + " --reader " + std::to_string(domain) + " " + ns + " 0");
+  sd::Participant p(domain);
+  sd::MapPublisherConfig cfg;
+  cfg.ns = ns;
+  cfg.blocks_hz = 1e6;
+  cfg.cloud_hz = 0.0;
+  sd::MapPublisher pub(p, cfg, description(cells));
+  reader.expect("ready");
+  while (pub.matched_readers() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  // 1000 distinct blocks, rewritten in new versions as fast as the writer goes.
+  constexpr int kBlocks = 1000;
+  std::vector<sd::BlockSnapshot> blocks;
+  for (int i = 0; i < kBlocks; ++i)
+    blocks.push_back(block({i % 10, i / 10 % 10, i / 100}, cells, 1));
+  std::uint64_t written = 0;
+  const auto start = Clock::now();
+  std::uint32_t version = 1;
+  while (Clock::now() - start < std::chrono::duration<double>(seconds)) {
+    ++version;
+    for (auto& b : blocks) {
+      b.version = version;
+      pub.update(b);
+    }
+    written += pub.publish_changed(Stamp::now());
+  }
+  const double wsecs = std::chrono::duration<double>(Clock::now() - start).count();
+  std::istringstream r(reader.expect("result").substr(7));
+  std::uint64_t n = 0, bytes = 0, bad = 0;
+  double secs = 0;
+  r >> n >> bytes >> secs >> bad;
+  Throughput t;
+  t.received = n;
+  t.bad = bad;
+  t.blocks_per_s = secs > 0 ? static_cast<double>(n) / secs : 0;
+  t.mb_per_s = secs > 0 ? static_cast<double>(bytes) / secs / 1e6 : 0;
+  t.written_per_s = static_cast<double>(written) / wsecs;
+  return t;
+}
+
+struct Latency {
+  double p50_us = 0, p99_us = 0, max_us = 0;
+  std::uint64_t samples = 0;
+};
+
+Latency latency(int domain, std::uint16_t cells, int blocks_per_update, double seconds) {
+  const std::string ns = "bench_lat" + std::to_string(blocks_per_update);
+  Pipe reader(self_path() + " --reader " + std::to_string(domain) + " " + ns + " 1");
+  sd::Participant p(domain);
+  sd::MapPublisherConfig cfg;
+  cfg.ns = ns;
+  cfg.blocks_hz = 10.0;
+  cfg.cloud_hz = 0.0;
+  sd::MapPublisher pub(p, cfg, description(cells));
+  reader.expect("ready");
+  while (pub.matched_readers() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  // Let the reader's side of the match settle too, or the first round arrives as historical
+  // (transient-local) data with a stale stamp.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto start = Clock::now();
+  std::uint32_t version = 0;
+  while (Clock::now() - start < std::chrono::duration<double>(seconds)) {
+    ++version;
+    for (int i = 0; i < blocks_per_update; ++i) pub.update(block({i, 0, 0}, cells, version));
+    pub.spin_once(Stamp::now());
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  std::istringstream r(reader.expect("result").substr(7));
+  Latency l;
+  std::uint64_t bytes = 0, bad = 0;
+  double secs = 0;
+  r >> l.samples >> bytes >> secs >> bad >> l.p50_us >> l.p99_us >> l.max_us;
+  return l;
+}
+
+// ddsperf's sample rate at the same payload size, same XML, same machine, same run: the median
+// of its per-second receive rates while the publisher runs.
+double ddsperf_rate(int domain, std::size_t size, double seconds, const std::string& qos) {
+  const int dur = static_cast<int>(seconds + 0.5);
+  Pipe sub("ddsperf -i " + std::to_string(domain) + " -D " + std::to_string(dur + 2) + qos +
+           " sub 2>&1");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const std::string pub = "ddsperf -i " + std::to_string(domain) + " -D " + std::to_string(dur) +
+                          qos + " pub size " + std::to_string(size) + " > /dev/null 2>&1";
+  if (std::system(pub.c_str()) != 0) throw std::runtime_error("ddsperf pub failed");
+  std::vector<double> rates;
+  std::string l;
+  while (sub.line(l)) {
+    const auto at = l.find(" rate ");
+    if (l.find(" size ") == std::string::npos || at == std::string::npos) continue;
+    const double kS = std::strtod(l.c_str() + at + 6, nullptr);
+    if (kS > 0) rates.push_back(kS * 1e3);
+  }
+  if (rates.size() > 2) rates.erase(rates.begin());  // ramp-up second
+  if (rates.empty()) return 0;
+  std::sort(rates.begin(), rates.end());
+  return rates[rates.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    // Pin DDS to loopback unless the caller chose a configuration.
+    setenv("CYCLONEDDS_URI", "file://" SEMAP_DDS_LOOPBACK_XML, 0);
+    if (argc == 5 && std::strcmp(argv[1], "--reader") == 0) {
+      return run_reader(std::atoi(argv[2]), argv[3], std::strcmp(argv[4], "1") == 0);
+    }
+    const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
+    const int reps = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
+    std::random_device rd;
+    const int domain = 1 + static_cast<int>(rd() % 200);
+    std::printf("dds_bench: domain %d, CYCLONEDDS_URI=%s, %.0f s a run, median of %d\n", domain,
+                std::getenv("CYCLONEDDS_URI"), seconds, reps);
+    // ddsperf twice: its default (reliable keep-all, one key: the baseline) and with
+    // our map QoS (keep-last 1 over 1000 keys), which cannot throttle the writer.
+    std::printf("%-22s %10s %8s %10s %14s %6s %16s %6s\n", "map blocks (no evid.)", "blocks/s",
+                "MB/s", "written/s", "ddsperf dflt/s", "ratio", "ddsperf k1 n1000", "ratio");
+    // Interleaved repetitions, medians reported: load from other processes comes and goes.
+    const auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    for (std::uint16_t cells : {5, 8}) {
+      const std::size_t bytes = block_bytes(cells);
+      std::vector<double> ours, mbs, written, ref, ref_k1;
+      std::uint64_t bad = 0;
+      for (int rep = 0; rep < reps; ++rep) {
+        const Throughput t = throughput(domain, cells, seconds);
+        ours.push_back(t.blocks_per_s);
+        mbs.push_back(t.mb_per_s);
+        written.push_back(t.written_per_s);
+        bad += t.bad;
+        ref.push_back(ddsperf_rate(domain, bytes, seconds, ""));
+        ref_k1.push_back(ddsperf_rate(domain, bytes, seconds, " -k 1 -n 1000"));
+      }
+      const double o = median(ours), r = median(ref), r1 = median(ref_k1);
+      char label[64];
+      std::snprintf(label, sizeof label, "%u^3 cells, %zu B", cells, bytes);
+      std::printf("%-22s %10.0f %8.1f %10.0f %14.0f %5.0f%% %16.0f %5.0f%%%s\n", label, o,
+                  median(mbs), median(written), r, r > 0 ? 100.0 * o / r : 0.0, r1,
+                  r1 > 0 ? 100.0 * o / r1 : 0.0, bad ? " (INVALID BLOCKS RECEIVED)" : "");
+      std::fflush(stdout);
+    }
+    for (int per_update : {10, 100}) {
+      const Latency l = latency(domain, 8, per_update, std::max(3.0, seconds));
+      std::printf(
+          "latency, 10 Hz x %3d changed 8^3 blocks: p50 %6.0f us  p99 %6.0f us  max %6.0f us"
+          " (%llu blocks)\n",
+          per_update, l.p50_us, l.p99_us, l.max_us, static_cast<unsigned long long>(l.samples));
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dds_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,44 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+
+#include "semap/common/messages.hpp"
+#include "semap/common/stamp.hpp"
+#include "semap/dds_idl/types.hpp"
+
+namespace semap::dds_idl {
+
+// Stamps go out as they are: nanoseconds of the robot's CLOCK_MONOTONIC split into sec/nanosec.
+// Negative stamps are clamped to zero (builtin_interfaces/Time cannot carry them meaningfully).
+msg::Time to_msg_time(common::Stamp stamp);
+common::Stamp from_msg_time(const msg::Time& t);
+
+// A pose estimate with its velocity, the plain form of nav_msgs/Odometry. Covariances are in
+// ROS order: (x, y, z, rotation about x, y, z); twist in the body (child) frame.
+struct PoseEstimate {
+  common::Stamp stamp;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // body to map
+  Eigen::Vector3d velocity_body = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity_body = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 6, 6> pose_covariance = Eigen::Matrix<double, 6, 6>::Identity();
+  Eigen::Matrix<double, 6, 6> twist_covariance = Eigen::Matrix<double, 6, 6>::Identity();
+};
+
+// The `frame_id` strings are borrowed: they must outlive the filled message.
+void to_msg(const common::ImuSample& s, const std::string& frame_id, double gyro_variance,
+            double accel_variance, msg::Imu& out);
+void to_msg(const common::GnssFix& f, const std::string& frame_id, msg::NavSatFix& out);
+void to_msg(const PoseEstimate& p, const std::string& frame_id, const std::string& child_frame_id,
+            msg::Odometry& out);
+void to_msg(const PoseEstimate& p, const std::string& frame_id,
+            msg::PoseWithCovarianceStamped& out);
+
+common::ImuSample from_msg(const msg::Imu& m);
+common::GnssFix from_msg(const msg::NavSatFix& m);
+PoseEstimate from_msg(const msg::Odometry& m);
+PoseEstimate from_msg(const msg::PoseWithCovarianceStamped& m);
+
+}  // namespace semap::dds_idl

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "semap/common/stamp.hpp"
+#include "semap/dds_idl/types.hpp"
+
+namespace semap::dds_idl {
+
+// The plain form of semap_msgs/Health, filled by the onboard app from its stages and drivers.
+struct StageHealthData {
+  std::string name;
+  float rate_hz = 0.0f;
+  std::uint32_t queue_depth = 0;
+  std::uint64_t drops = 0;
+  float latency_p50_ms = 0.0f;
+  float latency_p99_ms = 0.0f;
+};
+
+struct DriverCountersData {
+  std::string name;
+  std::uint64_t frames = 0;
+  std::uint64_t bad_frames = 0;
+  std::uint64_t dropped = 0;
+  std::uint64_t reconnects = 0;
+};
+
+struct HealthReport {
+  common::Stamp stamp;
+  std::vector<StageHealthData> stages;
+  std::vector<DriverCountersData> drivers;
+};
+
+// A Health message borrowing the report's strings: valid while the report lives unchanged.
+class HealthMessage {
+ public:
+  HealthMessage(const HealthReport& report, const std::string& frame_id);
+  HealthMessage(const HealthMessage&) = delete;
+  HealthMessage& operator=(const HealthMessage&) = delete;
+  const msg::Health& get() const { return msg_; }
+
+ private:
+  std::vector<msg::StageHealth> stages_;
+  std::vector<msg::DriverCounters> drivers_;
+  msg::Health msg_{};
+};
+
+HealthReport from_msg(const msg::Health& m);
+
+}  // namespace semap::dds_idl

@@ -1,0 +1,51 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "semap/common/stamp.hpp"
+#include "semap/dds_idl/block_snapshot.hpp"
+#include "semap/dds_idl/types.hpp"
+
+namespace semap::dds_idl {
+
+// Occupied cells as sensor_msgs/PointCloud2 for RViz: fields x, y, z, variance (float32) and
+// class (uint16), little endian, 20 bytes a point, one row.
+class MapCloud {
+ public:
+  static constexpr std::uint32_t kPointStep = 20;
+
+  explicit MapCloud(std::string frame_id);
+  MapCloud(const MapCloud&) = delete;
+  MapCloud& operator=(const MapCloud&) = delete;
+
+  void clear() { data_.clear(); }
+  void add(const Eigen::Vector3f& p, std::uint16_t cls, float variance);
+  void add_occupied(const BlockSnapshot& block);
+  std::size_t size() const { return data_.size() / kPointStep; }
+
+  // The message borrows this object's buffers: valid until the next add/clear.
+  const msg::PointCloud2& message(common::Stamp stamp);
+
+ private:
+  std::string frame_id_;
+  std::array<std::string, 5> names_{"x", "y", "z", "variance", "class"};
+  std::array<msg::PointField, 5> fields_{};
+  std::vector<std::uint8_t> data_;
+  msg::PointCloud2 msg_{};
+};
+
+struct CloudPoint {
+  Eigen::Vector3f position;
+  std::uint16_t cls = 0;
+  float variance = 0.0f;
+};
+
+// Reads a cloud written by MapCloud; throws std::runtime_error naming the field when the
+// layout differs.
+std::vector<CloudPoint> read_map_cloud(const msg::PointCloud2& m);
+
+}  // namespace semap::dds_idl

@@ -1,0 +1,78 @@
+#pragma once
+
+#include <array>
+#include <chrono>
+
+#include "semap/dds_idl/topic.hpp"
+
+namespace semap::dds_idl {
+
+// A typed data reader with a waitset on its data-available state.
+template <typename T>
+class Reader {
+ public:
+  Reader(const Participant& participant, const Topic<T>& topic, const Qos& qos)
+      : topic_name_(topic.name()),
+        entity_(check(dds_create_reader(participant.handle(), topic.handle(), qos.get(), nullptr),
+                      "dds_create_reader " + topic.name())),
+        condition_(check(dds_create_readcondition(entity_.handle(), DDS_ANY_STATE),
+                         "dds_create_readcondition")),
+        waitset_(check(dds_create_waitset(participant.handle()), "dds_create_waitset")) {
+    check(dds_waitset_attach(waitset_.handle(), condition_.handle(), 0), "dds_waitset_attach");
+  }
+
+  // Takes every available sample and calls f(const T&, const dds_sample_info_t&) for those
+  // carrying data (not for dispose/unregister notifications). Returns how many had data.
+  template <typename F>
+  std::size_t take_each(F&& f) {
+    std::size_t count = 0;
+    for (;;) {
+      std::array<void*, kBatch> samples{};
+      std::array<dds_sample_info_t, kBatch> infos{};
+      const dds_return_t n =
+          check(dds_take(entity_.handle(), samples.data(), infos.data(), kBatch, kBatch),
+                "dds_take " + topic_name_);
+      if (n == 0) break;
+      // The loan goes back even when f throws.
+      struct Loan {
+        dds_entity_t reader;
+        void** buf;
+        dds_return_t n;
+        ~Loan() { dds_return_loan(reader, buf, n); }
+      } loan{entity_.handle(), samples.data(), n};
+      for (dds_return_t i = 0; i < n; ++i) {
+        if (!infos[static_cast<std::size_t>(i)].valid_data) continue;
+        f(*static_cast<const T*>(samples[static_cast<std::size_t>(i)]),
+          infos[static_cast<std::size_t>(i)]);
+        ++count;
+      }
+      if (static_cast<std::size_t>(n) < kBatch) break;
+    }
+    return count;
+  }
+
+  // Blocks until a sample (or state change) is available; false on timeout.
+  bool wait(std::chrono::nanoseconds timeout) {
+    const dds_return_t rc = dds_waitset_wait(waitset_.handle(), nullptr, 0,
+                                             static_cast<dds_duration_t>(timeout.count()));
+    return check(rc, "dds_waitset_wait") > 0;
+  }
+
+  std::uint32_t matched() const {
+    dds_subscription_matched_status_t st{};
+    check(dds_get_subscription_matched_status(entity_.handle(), &st),
+          "dds_get_subscription_matched_status");
+    return st.current_count;
+  }
+
+  dds_entity_t handle() const { return entity_.handle(); }
+
+ private:
+  static constexpr std::size_t kBatch = 64;
+  std::string topic_name_;
+  Entity entity_;
+  Entity condition_;
+  Entity waitset_;
+};
+
+}  // namespace semap::dds_idl

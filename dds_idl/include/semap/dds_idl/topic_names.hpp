@@ -1,0 +1,20 @@
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "semap/dds_idl/qos.hpp"
+
+namespace semap::dds_idl {
+
+// The topics semap publishes, named as ROS 2 maps `/<ns>/semap/<leaf>` onto DDS.
+enum class SemapTopic { kOdometry, kPose, kGnss, kImu, kMapBlocks, kMapInfo, kMapCloud, kHealth };
+
+// "rt/semap/odometry" for an empty namespace, "rt/robot1/semap/odometry" for "robot1".
+// Throws std::invalid_argument for a namespace that is not a valid ROS 2 name.
+std::string topic_name(std::string_view ns, SemapTopic topic);
+
+// The QoS of each topic, used by writers and readers alike (docs/dds.md lists them).
+Qos topic_qos(SemapTopic topic);
+
+}  // namespace semap::dds_idl

@@ -1,0 +1,49 @@
+#pragma once
+
+#include <chrono>
+#include <thread>
+
+#include "semap/dds_idl/topic.hpp"
+
+namespace semap::dds_idl {
+
+// A typed data writer. `write` serialises the sample before returning, so borrowed sequence
+// buffers (see borrow_sequence) only need to live for the call.
+template <typename T>
+class Writer {
+ public:
+  Writer(const Participant& participant, const Topic<T>& topic, const Qos& qos)
+      : topic_name_(topic.name()),
+        entity_(check(dds_create_writer(participant.handle(), topic.handle(), qos.get(), nullptr),
+                      "dds_create_writer " + topic.name())) {}
+
+  void write(const T& sample) {
+    check(dds_write(entity_.handle(), &sample), "dds_write " + topic_name_);
+  }
+
+  // Number of currently matched readers.
+  std::uint32_t matched() const {
+    dds_publication_matched_status_t st{};
+    check(dds_get_publication_matched_status(entity_.handle(), &st),
+          "dds_get_publication_matched_status");
+    return st.current_count;
+  }
+
+  // Polls until at least `count` readers matched; false on timeout.
+  bool wait_for_readers(std::uint32_t count, std::chrono::milliseconds timeout) const {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (matched() < count) {
+      if (std::chrono::steady_clock::now() > deadline) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return true;
+  }
+
+  dds_entity_t handle() const { return entity_.handle(); }
+
+ private:
+  std::string topic_name_;
+  Entity entity_;
+};
+
+}  // namespace semap::dds_idl

@@ -1,0 +1,143 @@
+#include "semap/dds_idl/block_codec.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "semap/dds_idl/converters.hpp"
+
+namespace semap::dds_idl {
+
+BlockMessage::BlockMessage(const BlockSnapshot& b, common::Stamp stamp, std::string frame_id)
+    : frame_id_(std::move(frame_id)) {
+  msg_.header_.stamp_ = to_msg_time(stamp);
+  msg_.header_.frame_id_ = frame_id_.data();
+  msg_.ix_ = b.index.x;
+  msg_.iy_ = b.index.y;
+  msg_.iz_ = b.index.z;
+  msg_.resolution_ = b.resolution;
+  msg_.block_cells_ = b.block_cells;
+  msg_.num_classes_ = b.num_classes;
+  msg_.version_ = b.version;
+  // DDS only reads these during dds_write; the const_casts never lead to a write.
+  static_assert(sizeof(CellState) == sizeof(std::uint8_t));
+  msg_.state_ = borrow_sequence<dds_sequence_uint8>(
+      reinterpret_cast<std::uint8_t*>(const_cast<CellState*>(b.state.data())), b.state.size());
+  msg_.argmax_class_ = borrow_sequence<dds_sequence_unsigned_short>(
+      const_cast<std::uint16_t*>(b.argmax_class.data()), b.argmax_class.size());
+  msg_.variance_ =
+      borrow_sequence<dds_sequence_float>(const_cast<float*>(b.variance.data()), b.variance.size());
+  msg_.evidence_ =
+      borrow_sequence<dds_sequence_float>(const_cast<float*>(b.evidence.data()), b.evidence.size());
+}
+
+const char* to_string(BlockReject reason) {
+  switch (reason) {
+    case BlockReject::kNone:
+      return "ok";
+    case BlockReject::kShape:
+      return "shape";
+    case BlockReject::kClassCount:
+      return "class count";
+    case BlockReject::kNonFinite:
+      return "non-finite value";
+    case BlockReject::kOutOfRange:
+      return "value out of range";
+    case BlockReject::kUnknownIndex:
+      return "unknown block index";
+  }
+  return "?";
+}
+
+namespace {
+
+DecodedBlock reject(const msg::SemanticMapBlock& m, BlockReject reason, const std::string& what) {
+  std::ostringstream os;
+  os << "SemanticMapBlock (" << m.ix_ << "," << m.iy_ << "," << m.iz_ << ") v" << m.version_ << ": "
+     << what;
+  return {std::nullopt, reason, os.str()};
+}
+
+template <typename Seq>
+std::optional<std::size_t> first_bad_float(const Seq& s) {
+  for (std::uint32_t i = 0; i < s._length; ++i) {
+    if (!std::isfinite(s._buffer[i])) return i;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+DecodedBlock decode_block(const msg::SemanticMapBlock& m, const BlockLimits& limits) {
+  const auto index_ok = [&](std::int32_t v) {
+    return v >= -limits.max_abs_index && v <= limits.max_abs_index;
+  };
+  if (!index_ok(m.ix_) || !index_ok(m.iy_) || !index_ok(m.iz_)) {
+    return reject(m, BlockReject::kUnknownIndex,
+                  "index beyond +-" + std::to_string(limits.max_abs_index));
+  }
+  if (!std::isfinite(m.resolution_) || m.resolution_ <= 0.0f ||
+      (limits.resolution > 0.0f &&
+       std::fabs(m.resolution_ - limits.resolution) > 1e-6f * limits.resolution)) {
+    return reject(m, BlockReject::kShape, "resolution " + std::to_string(m.resolution_));
+  }
+  if (m.block_cells_ == 0 || m.block_cells_ > 64 ||
+      (limits.block_cells != 0 && m.block_cells_ != limits.block_cells)) {
+    return reject(m, BlockReject::kShape, "block_cells " + std::to_string(m.block_cells_));
+  }
+  if (m.num_classes_ == 0 || (limits.num_classes != 0 && m.num_classes_ != limits.num_classes)) {
+    return reject(m, BlockReject::kClassCount,
+                  "num_classes " + std::to_string(m.num_classes_) + ", map has " +
+                      std::to_string(limits.num_classes));
+  }
+  const std::size_t cells =
+      static_cast<std::size_t>(m.block_cells_) * m.block_cells_ * m.block_cells_;
+  if (m.state_._length != cells || m.argmax_class_._length != cells ||
+      m.variance_._length != cells) {
+    return reject(m, BlockReject::kShape,
+                  "state/argmax_class/variance lengths " + std::to_string(m.state_._length) + "/" +
+                      std::to_string(m.argmax_class_._length) + "/" +
+                      std::to_string(m.variance_._length) + ", expected " + std::to_string(cells));
+  }
+  if (m.evidence_._length != 0 && m.evidence_._length != cells * m.num_classes_) {
+    return reject(m, BlockReject::kClassCount,
+                  "evidence length " + std::to_string(m.evidence_._length) + " is not cells * " +
+                      std::to_string(m.num_classes_));
+  }
+  if (auto i = first_bad_float(m.variance_)) {
+    return reject(m, BlockReject::kNonFinite, "variance[" + std::to_string(*i) + "]");
+  }
+  if (auto i = first_bad_float(m.evidence_)) {
+    return reject(m, BlockReject::kNonFinite, "evidence[" + std::to_string(*i) + "]");
+  }
+  for (std::size_t i = 0; i < cells; ++i) {
+    if (m.state_._buffer[i] > static_cast<std::uint8_t>(CellState::kOccupied)) {
+      return reject(m, BlockReject::kOutOfRange, "state[" + std::to_string(i) + "]");
+    }
+    if (m.argmax_class_._buffer[i] >= m.num_classes_) {
+      return reject(m, BlockReject::kOutOfRange, "argmax_class[" + std::to_string(i) + "]");
+    }
+    if (m.variance_._buffer[i] < 0.0f) {
+      return reject(m, BlockReject::kOutOfRange, "variance[" + std::to_string(i) + "] < 0");
+    }
+  }
+  for (std::uint32_t i = 0; i < m.evidence_._length; ++i) {
+    if (m.evidence_._buffer[i] < 0.0f) {
+      return reject(m, BlockReject::kOutOfRange, "evidence[" + std::to_string(i) + "] < 0");
+    }
+  }
+
+  BlockSnapshot b;
+  b.index = {m.ix_, m.iy_, m.iz_};
+  b.resolution = m.resolution_;
+  b.block_cells = m.block_cells_;
+  b.num_classes = m.num_classes_;
+  b.version = m.version_;
+  b.state.resize(cells);
+  for (std::size_t i = 0; i < cells; ++i) b.state[i] = static_cast<CellState>(m.state_._buffer[i]);
+  b.argmax_class.assign(m.argmax_class_._buffer, m.argmax_class_._buffer + cells);
+  b.variance.assign(m.variance_._buffer, m.variance_._buffer + cells);
+  b.evidence.assign(m.evidence_._buffer, m.evidence_._buffer + m.evidence_._length);
+  return {std::move(b), BlockReject::kNone, {}};
+}
+
+}  // namespace semap::dds_idl

@@ -1,0 +1,127 @@
+#include "semap/dds_idl/map_client.hpp"
+
+#include <fstream>
+#include <numeric>
+#include <stdexcept>
+
+#include "semap/common/logging.hpp"
+#include "semap/dds_idl/topic_names.hpp"
+
+namespace semap::dds_idl {
+
+std::uint64_t MapClientCounters::rejected_total() const {
+  return std::accumulate(rejected.begin(), rejected.end(), std::uint64_t{0});
+}
+
+MapClient::MapClient(const Participant& participant, MapClientConfig config)
+    : config_(std::move(config)),
+      block_topic_(participant, topic_name(config_.ns, SemapTopic::kMapBlocks)),
+      block_reader_(participant, block_topic_, topic_qos(SemapTopic::kMapBlocks)),
+      info_topic_(participant, topic_name(config_.ns, SemapTopic::kMapInfo)),
+      info_reader_(participant, info_topic_, topic_qos(SemapTopic::kMapInfo)) {}
+
+std::size_t MapClient::poll() {
+  // MapInfo first: it may fix the shape the blocks are checked against.
+  info_reader_.take_each([this](const msg::MapInfo& m, const dds_sample_info_t&) { on_info(m); });
+  const std::uint64_t before = counters_.accepted;
+  block_reader_.take_each(
+      [this](const msg::SemanticMapBlock& m, const dds_sample_info_t&) { on_block(m); });
+  return static_cast<std::size_t>(counters_.accepted - before);
+}
+
+bool MapClient::wait_for_blocks(std::size_t count, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    poll();
+    if (blocks_.size() >= count) return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) return false;
+    block_reader_.wait(
+        std::min<std::chrono::nanoseconds>(deadline - now, std::chrono::milliseconds(50)));
+  }
+}
+
+void MapClient::on_info(const msg::MapInfo& m) {
+  try {
+    MapDescription d = from_msg(m);
+    BlockLimits& l = config_.limits;
+    const bool conflicts = (l.num_classes != 0 && l.num_classes != d.num_classes) ||
+                           (l.block_cells != 0 && l.block_cells != d.block_cells) ||
+                           (l.resolution > 0.0f && l.resolution != d.resolution);
+    if (conflicts) {
+      throw std::runtime_error("MapInfo: shape (" + std::to_string(d.num_classes) + " classes, " +
+                               std::to_string(d.block_cells) +
+                               " cells) differs from the expected one");
+    }
+    l.num_classes = d.num_classes;
+    l.block_cells = d.block_cells;
+    l.resolution = d.resolution;
+    info_ = std::move(d);
+    ++counters_.infos;
+  } catch (const std::exception& e) {
+    ++counters_.infos_rejected;
+    last_error_ = e.what();
+    common::logger("dds.map_client")->warn("{}", last_error_);
+  }
+}
+
+void MapClient::on_block(const msg::SemanticMapBlock& m) {
+  DecodedBlock d = decode_block(m, config_.limits);
+  if (!d.block) {
+    ++counters_.rejected[static_cast<std::size_t>(d.reason)];
+    last_error_ = std::move(d.error);
+    common::logger("dds.map_client")->warn("rejected {}", last_error_);
+    return;
+  }
+  BlockSnapshot& b = *d.block;
+  BlockLimits& l = config_.limits;
+  // Without MapInfo the first valid block fixes the shape of the map.
+  if (l.num_classes == 0) l.num_classes = b.num_classes;
+  if (l.block_cells == 0) l.block_cells = b.block_cells;
+  if (l.resolution <= 0.0f) l.resolution = b.resolution;
+
+  auto it = blocks_.find(b.index);
+  if (it != blocks_.end() && it->second.version > b.version) {
+    ++counters_.stale;
+    return;
+  }
+  changed_.push_back(b.index);
+  blocks_.insert_or_assign(b.index, std::move(b));
+  ++counters_.accepted;
+}
+
+std::vector<BlockIndex> MapClient::take_changed() { return std::exchange(changed_, {}); }
+
+CellQuery MapClient::query(const Eigen::Vector3f& p) const {
+  const BlockLimits& l = config_.limits;
+  if (l.resolution <= 0.0f || l.block_cells == 0) return {};
+  const BlockIndex index = block_of(p, l.resolution, l.block_cells);
+  const auto it = blocks_.find(index);
+  if (it == blocks_.end()) return {};
+  const BlockSnapshot& b = it->second;
+  const std::size_t cell = cell_of(p, index, b.resolution, b.block_cells);
+  return {true, b.state[cell], b.argmax_class[cell], b.variance[cell]};
+}
+
+void MapClient::save_pcd(const std::filesystem::path& path) const {
+  std::size_t n = 0;
+  for (const auto& [index, b] : blocks_) {
+    for (CellState s : b.state) n += s == CellState::kOccupied;
+  }
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+  out << "# .PCD v0.7 - semap map received over DDS\nVERSION 0.7\n"
+      << "FIELDS x y z class variance\nSIZE 4 4 4 2 4\nTYPE F F F U F\nCOUNT 1 1 1 1 1\n"
+      << "WIDTH " << n << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << n << "\nDATA ascii\n";
+  for (const auto& [index, b] : blocks_) {
+    for (std::size_t i = 0; i < b.state.size(); ++i) {
+      if (b.state[i] != CellState::kOccupied) continue;
+      const Eigen::Vector3f c = b.cell_center(i);
+      out << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << b.argmax_class[i] << ' '
+          << b.variance[i] << '\n';
+    }
+  }
+  if (!out) throw std::runtime_error("error writing " + path.string());
+}
+
+}  // namespace semap::dds_idl

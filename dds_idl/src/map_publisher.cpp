@@ -1,0 +1,112 @@
+#include "semap/dds_idl/map_publisher.hpp"
+
+#include <stdexcept>
+
+#include "semap/dds_idl/block_codec.hpp"
+#include "semap/dds_idl/topic_names.hpp"
+
+namespace semap::dds_idl {
+
+namespace {
+
+common::Stamp after(common::Stamp now, double hz) {
+  return hz > 0.0 ? now + 1.0 / hz : common::Stamp(INT64_MAX);
+}
+
+}  // namespace
+
+MapPublisher::MapPublisher(const Participant& participant, MapPublisherConfig config,
+                           MapDescription description)
+    : config_(std::move(config)),
+      description_(std::move(description)),
+      block_topic_(participant, topic_name(config_.ns, SemapTopic::kMapBlocks)),
+      block_writer_(participant, block_topic_, topic_qos(SemapTopic::kMapBlocks)),
+      info_topic_(participant, topic_name(config_.ns, SemapTopic::kMapInfo)),
+      info_writer_(participant, info_topic_, topic_qos(SemapTopic::kMapInfo)),
+      cloud_topic_(participant, topic_name(config_.ns, SemapTopic::kMapCloud)),
+      cloud_writer_(participant, cloud_topic_, topic_qos(SemapTopic::kMapCloud)),
+      cloud_(config_.frame_id) {
+  if (config_.blocks_hz <= 0.0) throw std::invalid_argument("MapPublisher: blocks_hz must be > 0");
+  if (description_.num_classes == 0) {
+    throw std::invalid_argument("MapPublisher: num_classes must be > 0");
+  }
+}
+
+void MapPublisher::update(BlockSnapshot block) {
+  const std::size_t cells = block.cell_count();
+  const bool shape_ok =
+      block.resolution == description_.resolution &&
+      block.block_cells == description_.block_cells &&
+      block.num_classes == description_.num_classes && block.state.size() == cells &&
+      block.argmax_class.size() == cells && block.variance.size() == cells &&
+      (block.evidence.empty() || block.evidence.size() == cells * block.num_classes);
+  if (!shape_ok) {
+    throw std::invalid_argument("MapPublisher::update: block shape differs from the map's");
+  }
+  const BlockIndex index = block.index;
+  auto [it, inserted] = blocks_.insert_or_assign(index, std::move(block));
+  (void)it;
+  if (inserted) info_dirty_ = true;
+  changed_.insert(index);
+}
+
+std::size_t MapPublisher::spin_once(common::Stamp now) {
+  std::size_t written = 0;
+  if (now >= next_blocks_) {
+    written = publish_changed(now);
+    next_blocks_ = after(now, config_.blocks_hz);
+  }
+  if (now >= next_cloud_ && config_.cloud_hz > 0.0) {
+    publish_cloud(now);
+    next_cloud_ = after(now, config_.cloud_hz);
+  }
+  return written;
+}
+
+std::size_t MapPublisher::publish_changed(common::Stamp now) {
+  if (info_dirty_) publish_info(now);
+  std::size_t written = 0;
+  for (auto it = changed_.begin(); it != changed_.end();) {
+    const BlockMessage m(blocks_.at(*it), now, config_.frame_id);
+    try {
+      block_writer_.write(m.get());
+    } catch (const DdsError& e) {
+      if (e.code() != DDS_RETCODE_TIMEOUT) throw;
+      ++counters_.write_timeouts;
+      break;
+    }
+    it = changed_.erase(it);
+    ++written;
+  }
+  counters_.blocks_written += written;
+  if (written > 0) ++counters_.block_publications;
+  return written;
+}
+
+void MapPublisher::publish_cloud(common::Stamp now) {
+  cloud_.clear();
+  for (const auto& [index, block] : blocks_) cloud_.add_occupied(block);
+  cloud_writer_.write(cloud_.message(now));
+  ++counters_.clouds_written;
+}
+
+void MapPublisher::publish_info(common::Stamp now) {
+  if (!blocks_.empty()) {
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector3f hi = -lo;
+    for (const auto& [index, block] : blocks_) {
+      lo = lo.cwiseMin(block.origin());
+      hi = hi.cwiseMax(block.origin() + Eigen::Vector3f::Constant(block.block_side()));
+    }
+    description_.min_bound = lo.cast<double>();
+    description_.max_bound = hi.cast<double>();
+  }
+  description_.num_blocks = static_cast<std::uint32_t>(blocks_.size());
+  ++description_.sequence;
+  const MapInfoMessage m(description_, now, config_.frame_id);
+  info_writer_.write(m.get());
+  ++counters_.infos_written;
+  info_dirty_ = false;
+}
+
+}  // namespace semap::dds_idl

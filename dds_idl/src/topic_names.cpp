@@ -1,0 +1,81 @@
+#include "semap/dds_idl/topic_names.hpp"
+
+#include <cctype>
+#include <stdexcept>
+
+namespace semap::dds_idl {
+
+namespace {
+
+std::string_view leaf(SemapTopic topic) {
+  switch (topic) {
+    case SemapTopic::kOdometry:
+      return "odometry";
+    case SemapTopic::kPose:
+      return "pose";
+    case SemapTopic::kGnss:
+      return "gnss";
+    case SemapTopic::kImu:
+      return "imu";
+    case SemapTopic::kMapBlocks:
+      return "map_blocks";
+    case SemapTopic::kMapInfo:
+      return "map_info";
+    case SemapTopic::kMapCloud:
+      return "map_cloud";
+    case SemapTopic::kHealth:
+      return "health";
+  }
+  throw std::invalid_argument("unknown SemapTopic");
+}
+
+void validate_namespace(std::string_view ns) {
+  bool previous_slash = true;
+  for (char c : ns) {
+    const bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '/';
+    if (!ok || (c == '/' && previous_slash)) {
+      throw std::invalid_argument("DDS namespace '" + std::string(ns) +
+                                  "' is not a ROS 2 name (letters, digits, _ and single /)");
+    }
+    previous_slash = c == '/';
+  }
+  if (!ns.empty() && (ns.back() == '/' || std::isdigit(static_cast<unsigned char>(ns.front())))) {
+    throw std::invalid_argument("DDS namespace '" + std::string(ns) +
+                                "' must not end with / or start with a digit");
+  }
+}
+
+}  // namespace
+
+std::string topic_name(std::string_view ns, SemapTopic topic) {
+  validate_namespace(ns);
+  std::string name = "rt/";
+  if (!ns.empty()) {
+    name += ns;
+    name += '/';
+  }
+  name += "semap/";
+  name += leaf(topic);
+  return name;
+}
+
+Qos topic_qos(SemapTopic topic) {
+  switch (topic) {
+    case SemapTopic::kOdometry:
+    case SemapTopic::kGnss:
+    case SemapTopic::kImu:
+      return std::move(Qos().best_effort().keep_last(topic == SemapTopic::kOdometry ? 1 : 10));
+    case SemapTopic::kPose:
+    case SemapTopic::kMapCloud:
+      return std::move(Qos().reliable().keep_last(1));
+    case SemapTopic::kMapBlocks:
+    case SemapTopic::kMapInfo:
+      // Late joiners get the current version of every block from the writer's history.
+      return std::move(Qos().reliable().transient_local().keep_last(1));
+    case SemapTopic::kHealth:
+      return std::move(Qos().reliable().keep_last(10));
+  }
+  throw std::invalid_argument("unknown SemapTopic");
+}
+
+}  // namespace semap::dds_idl

@@ -1,0 +1,197 @@
+// Map topics between two real processes on loopback: late join, listener restart, rejection of
+// malformed samples, publication of changed blocks only, fusion of two robots.
+#include <gmock/gmock.h>
+
+#include <thread>
+
+#include "dds_fixture.hpp"
+#include "semap/dds_idl/map_client.hpp"
+#include "semap/dds_idl/map_fusion.hpp"
+#include "semap/dds_idl/map_publisher.hpp"
+#include "test_blocks.hpp"
+
+namespace semap::dds_idl::testing {
+namespace {
+
+using common::Stamp;
+
+MapDescription test_description(std::uint16_t classes) {
+  MapDescription d;
+  d.resolution = 0.2f;
+  d.block_cells = 4;
+  d.num_classes = classes;
+  return d;
+}
+
+TEST_F(DdsTest, LateJoiningListenerReceivesWholeMap) {
+  const std::string ns = unique_ns("late");
+  ChildProcess pub(peer("map-pub", {"--ns", ns, "--blocks", "300", "--classes", "6", "--version",
+                                    "3", "--seconds", "30"}));
+  ASSERT_TRUE(pub.expect("published 300", seconds(10)));
+  // The map was written before this participant existed: only transient-local history can
+  // bring it here.
+  std::this_thread::sleep_for(milliseconds(300));
+  Participant participant(test_domain());
+  MapClient client(participant, {ns, {}});
+  ASSERT_TRUE(client.wait_for_blocks(300, seconds(15)))
+      << "got " << client.blocks().size() << " blocks";
+  for (const auto& [index, block] : client.blocks()) {
+    ASSERT_TRUE(same_content(block, make_block(index, 3, 6, false)));
+  }
+  ASSERT_TRUE(client.info().has_value());
+  EXPECT_EQ(client.info()->num_classes, 6);
+  EXPECT_EQ(client.info()->num_blocks, 300u);
+  ASSERT_EQ(client.info()->class_names.size(), 6u);
+  EXPECT_EQ(client.info()->class_names[5], "class5");
+  EXPECT_EQ(client.counters().rejected_total(), 0u);
+
+  // query() answers from the rebuilt map: every cell of one block, by position.
+  const BlockSnapshot expected = make_block(grid_index(42), 3, 6, false);
+  for (std::size_t cell = 0; cell < expected.cell_count(); ++cell) {
+    const CellQuery q = client.query(expected.cell_center(cell));
+    ASSERT_TRUE(q.known_block);
+    EXPECT_EQ(q.state, expected.state[cell]);
+    EXPECT_EQ(q.cls, expected.argmax_class[cell]);
+    EXPECT_EQ(q.variance, expected.variance[cell]);
+  }
+  EXPECT_FALSE(client.query(Eigen::Vector3f(100.0f, 100.0f, 100.0f)).known_block);
+}
+
+TEST_F(DdsTest, KilledAndRestartedListenerRecoversMap) {
+  const std::string ns = unique_ns("restart");
+  Participant participant(test_domain());
+  MapPublisherConfig cfg;
+  cfg.ns = ns;
+  MapPublisher pub(participant, cfg, test_description(4));
+  for (int i = 0; i < 120; ++i) pub.update(make_block(grid_index(i), 1, 4, true));
+  pub.publish_changed(Stamp::now());
+
+  {
+    ChildProcess listener(peer("map-listen", {"--ns", ns, "--blocks", "120", "--classes", "4",
+                                              "--version", "1", "--seconds", "20"}));
+    ASSERT_TRUE(listener.expect("match 120", seconds(15)));
+    listener.kill();  // SIGKILL: no goodbye, the writer learns only by lease expiry
+  }
+  // The map moves on while no listener runs.
+  for (int i = 0; i < 120; ++i) pub.update(make_block(grid_index(i), 2, 4, true));
+  EXPECT_EQ(pub.publish_changed(Stamp::now()), 120u);
+
+  ChildProcess restarted(peer("map-listen", {"--ns", ns, "--blocks", "120", "--classes", "4",
+                                             "--version", "2", "--seconds", "20"}));
+  EXPECT_TRUE(restarted.expect("match 120", seconds(15)));
+  EXPECT_EQ(restarted.wait(), 0);
+}
+
+TEST_F(DdsTest, MalformedBlocksAreRejectedAndCounted) {
+  const std::string ns = unique_ns("bad");
+  Participant participant(test_domain());
+  MapClientConfig cfg;
+  cfg.ns = ns;
+  cfg.limits.num_classes = 5;
+  MapClient client(participant, cfg);
+  ChildProcess bad(peer("bad-pub", {"--ns", ns, "--classes", "5", "--seconds", "20"}));
+  ASSERT_TRUE(bad.expect("published 9", seconds(10)));
+
+  const auto deadline = std::chrono::steady_clock::now() + seconds(10);
+  while (client.counters().accepted + client.counters().rejected_total() < 9 &&
+         std::chrono::steady_clock::now() < deadline) {
+    client.wait_for_blocks(100, milliseconds(100));
+  }
+  const MapClientCounters& c = client.counters();
+  EXPECT_EQ(c.accepted, 2u);
+  EXPECT_EQ(c.rejected_for(BlockReject::kClassCount), 1u);
+  EXPECT_EQ(c.rejected_for(BlockReject::kNonFinite), 2u);
+  EXPECT_EQ(c.rejected_for(BlockReject::kUnknownIndex), 1u);
+  EXPECT_EQ(c.rejected_for(BlockReject::kOutOfRange), 2u);
+  EXPECT_EQ(c.rejected_for(BlockReject::kShape), 1u);
+  EXPECT_EQ(client.blocks().size(), 2u);
+  EXPECT_TRUE(client.blocks().contains({0, 0, 0}));
+  EXPECT_TRUE(client.blocks().contains({7, 0, 0}));
+  EXPECT_FALSE(client.last_error().empty());
+}
+
+TEST_F(DdsTest, PublisherSendsOnlyChangedBlocksAtItsRate) {
+  const std::string ns = unique_ns("changed");
+  Participant participant(test_domain());
+  MapPublisherConfig cfg;
+  cfg.ns = ns;
+  cfg.blocks_hz = 2.0;
+  cfg.cloud_hz = 0.0;
+  MapPublisher pub(participant, cfg, test_description(3));
+  MapClient client(participant, {ns, {}});
+
+  for (int i = 0; i < 20; ++i) pub.update(make_block(grid_index(i), 1, 3, false));
+  const Stamp t0 = Stamp::now();
+  EXPECT_EQ(pub.spin_once(t0), 20u);
+  ASSERT_TRUE(client.wait_for_blocks(20, seconds(10)));
+  client.take_changed();
+
+  // Three blocks change, one of them twice: the next round sends three, in the latest version.
+  pub.update(make_block(grid_index(1), 2, 3, false));
+  pub.update(make_block(grid_index(2), 2, 3, false));
+  pub.update(make_block(grid_index(3), 2, 3, false));
+  pub.update(make_block(grid_index(3), 3, 3, false));
+  EXPECT_EQ(pub.spin_once(t0 + 0.1), 0u) << "rate limit: 2 Hz";
+  EXPECT_EQ(pub.pending(), 3u);
+  EXPECT_EQ(pub.spin_once(t0 + 0.6), 3u);
+  EXPECT_EQ(pub.counters().blocks_written, 23u);
+
+  const auto deadline = std::chrono::steady_clock::now() + seconds(10);
+  while (client.counters().accepted < 23 && std::chrono::steady_clock::now() < deadline) {
+    client.wait_for_blocks(100, milliseconds(50));
+  }
+  EXPECT_EQ(client.counters().accepted, 23u);
+  EXPECT_EQ(client.blocks().at(grid_index(3)).version, 3u);
+  EXPECT_THAT(client.take_changed(),
+              ::testing::UnorderedElementsAre(grid_index(1), grid_index(2), grid_index(3)));
+  EXPECT_THROW(pub.update(make_block({0, 0, 0}, 1, 4, false)), std::invalid_argument);
+}
+
+TEST_F(DdsTest, FusionMergesEvidenceOfTwoRobots) {
+  const std::string a = unique_ns("robot_a");
+  const std::string b = unique_ns("robot_b");
+  ChildProcess pub_a(peer("map-pub", {"--ns", a, "--blocks", "30", "--classes", "4", "--version",
+                                      "1", "--evidence", "--seconds", "30"}));
+  ChildProcess pub_b(peer("map-pub", {"--ns", b, "--blocks", "30", "--classes", "4", "--version",
+                                      "2", "--evidence", "--seconds", "30"}));
+  ASSERT_TRUE(pub_a.expect("published 30", seconds(10)));
+  ASSERT_TRUE(pub_b.expect("published 30", seconds(10)));
+
+  Participant participant(test_domain());
+  MapFusionConfig cfg;
+  cfg.robots = {a, b};
+  cfg.output.ns = unique_ns("fused");
+  cfg.output.blocks_hz = 20.0;
+  cfg.description = test_description(4);
+  MapFusion fusion(participant, cfg);
+  MapClient fused(participant, {cfg.output.ns, {}});
+
+  // A block merged before the other robot's copy arrived is merged again later; wait for the
+  // versions of both (1 + 2).
+  const auto all_merged = [&] {
+    if (fused.blocks().size() < 30) return false;
+    for (const auto& [index, block] : fused.blocks()) {
+      if (block.version != 3) return false;
+    }
+    return true;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + seconds(15);
+  while (!all_merged() && std::chrono::steady_clock::now() < deadline) {
+    fusion.spin_once(Stamp::now());
+    fused.wait_for_blocks(30, milliseconds(50));
+  }
+  ASSERT_EQ(fusion.robot(0).blocks().size(), 30u);
+  ASSERT_EQ(fusion.robot(1).blocks().size(), 30u);
+  ASSERT_EQ(fused.blocks().size(), 30u);
+  for (const auto& [index, block] : fused.blocks()) {
+    const BlockSnapshot ea = make_block(index, 1, 4, true);
+    const BlockSnapshot eb = make_block(index, 2, 4, true);
+    ASSERT_EQ(block.evidence.size(), ea.evidence.size());
+    for (std::size_t i = 0; i < ea.evidence.size(); ++i) {
+      ASSERT_FLOAT_EQ(block.evidence[i], ea.evidence[i] + eb.evidence[i]);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace semap::dds_idl::testing

@@ -1,0 +1,161 @@
+#include "semap/dds_idl/block_codec.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "semap/dds_idl/map_cloud.hpp"
+#include "semap/dds_idl/map_description.hpp"
+
+namespace semap::dds_idl {
+namespace {
+
+BlockSnapshot sample_block(bool evidence) {
+  BlockSnapshot b = BlockSnapshot::empty({-3, 4, 0}, 0.25f, 4, 3, evidence);
+  b.version = 9;
+  for (std::size_t i = 0; i < b.cell_count(); ++i) {
+    b.state[i] = static_cast<CellState>(i % 3);
+    b.argmax_class[i] = static_cast<std::uint16_t>(i % 3);
+    b.variance[i] = 0.001f * static_cast<float>(i);
+  }
+  for (std::size_t i = 0; i < b.evidence.size(); ++i) b.evidence[i] = static_cast<float>(i % 5);
+  return b;
+}
+
+TEST(BlockCodec, RoundTripKeepsEveryField) {
+  for (bool evidence : {false, true}) {
+    const BlockSnapshot b = sample_block(evidence);
+    const BlockMessage m(b, common::Stamp(1'500'000'123), "map");
+    EXPECT_EQ(m.get().header_.stamp_.sec_, 1);
+    EXPECT_EQ(m.get().header_.stamp_.nanosec_, 500'000'123u);
+    const DecodedBlock d = decode_block(m.get(), {});
+    ASSERT_TRUE(d.block) << d.error;
+    EXPECT_EQ(d.block->index, b.index);
+    EXPECT_EQ(d.block->version, 9u);
+    EXPECT_EQ(d.block->state, b.state);
+    EXPECT_EQ(d.block->argmax_class, b.argmax_class);
+    EXPECT_EQ(d.block->variance, b.variance);
+    EXPECT_EQ(d.block->evidence, b.evidence);
+  }
+}
+
+// Decodes `b` after `spoil` changed its message or limits.
+DecodedBlock decode_spoiled(BlockSnapshot b, const BlockLimits& limits = {}) {
+  const BlockMessage m(b, common::Stamp(1), "map");
+  return decode_block(m.get(), limits);
+}
+
+TEST(BlockCodec, RejectsEachKindOfBadBlockWithItsReason) {
+  BlockLimits three_classes;
+  three_classes.num_classes = 3;
+  BlockLimits four_classes;
+  four_classes.num_classes = 4;
+  EXPECT_EQ(decode_spoiled(sample_block(false), four_classes).reason, BlockReject::kClassCount);
+  EXPECT_EQ(decode_spoiled(sample_block(false), three_classes).reason, BlockReject::kNone);
+
+  auto nan = sample_block(false);
+  nan.variance[7] = std::numeric_limits<float>::quiet_NaN();
+  const DecodedBlock d = decode_spoiled(nan);
+  EXPECT_EQ(d.reason, BlockReject::kNonFinite);
+  EXPECT_NE(d.error.find("(-3,4,0)"), std::string::npos) << d.error;
+  EXPECT_NE(d.error.find("variance[7]"), std::string::npos) << d.error;
+
+  auto inf = sample_block(true);
+  inf.evidence[2] = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(decode_spoiled(inf).reason, BlockReject::kNonFinite);
+
+  auto far = sample_block(false);
+  far.index.x = 5000;
+  BlockLimits small_map;
+  small_map.max_abs_index = 1000;
+  EXPECT_EQ(decode_spoiled(far, small_map).reason, BlockReject::kUnknownIndex);
+
+  auto state = sample_block(false);
+  state.state[0] = static_cast<CellState>(3);
+  EXPECT_EQ(decode_spoiled(state).reason, BlockReject::kOutOfRange);
+
+  auto cls = sample_block(false);
+  cls.argmax_class[0] = 3;
+  EXPECT_EQ(decode_spoiled(cls).reason, BlockReject::kOutOfRange);
+
+  auto negative = sample_block(false);
+  negative.variance[0] = -1.0f;
+  EXPECT_EQ(decode_spoiled(negative).reason, BlockReject::kOutOfRange);
+
+  auto shape = sample_block(false);
+  shape.argmax_class.resize(10);
+  EXPECT_EQ(decode_spoiled(shape).reason, BlockReject::kShape);
+
+  auto evidence = sample_block(true);
+  evidence.evidence.pop_back();
+  EXPECT_EQ(decode_spoiled(evidence).reason, BlockReject::kClassCount);
+
+  auto resolution = sample_block(false);
+  resolution.resolution = 0.0f;
+  EXPECT_EQ(decode_spoiled(resolution).reason, BlockReject::kShape);
+  BlockLimits other_resolution;
+  other_resolution.resolution = 0.1f;
+  EXPECT_EQ(decode_spoiled(sample_block(false), other_resolution).reason, BlockReject::kShape);
+}
+
+TEST(BlockGeometry, PointsMapToTheCellWhoseCentreTheyAreNear) {
+  const BlockSnapshot b = BlockSnapshot::empty({-2, 0, 5}, 0.2f, 4, 2, false);
+  for (std::size_t i = 0; i < b.cell_count(); ++i) {
+    const Eigen::Vector3f c = b.cell_center(i);
+    EXPECT_EQ(block_of(c, 0.2f, 4), b.index);
+    EXPECT_EQ(cell_of(c, b.index, 0.2f, 4), i);
+    // Slightly off-centre stays in the same cell.
+    EXPECT_EQ(cell_of(c + Eigen::Vector3f::Constant(0.09f), b.index, 0.2f, 4), i);
+  }
+  EXPECT_EQ(block_of(Eigen::Vector3f(-0.01f, 0.0f, 0.0f), 0.2f, 4), (BlockIndex{-1, 0, 0}));
+}
+
+TEST(MapCloud, ReadsBackWhatItWrote) {
+  MapCloud cloud("map");
+  const BlockSnapshot b = sample_block(false);
+  cloud.add_occupied(b);
+  const auto points = read_map_cloud(cloud.message(common::Stamp(5)));
+  std::size_t occupied = 0;
+  for (std::size_t i = 0; i < b.cell_count(); ++i) {
+    if (b.state[i] != CellState::kOccupied) continue;
+    ASSERT_LT(occupied, points.size());
+    EXPECT_TRUE(points[occupied].position.isApprox(b.cell_center(i)));
+    EXPECT_EQ(points[occupied].cls, b.argmax_class[i]);
+    EXPECT_EQ(points[occupied].variance, b.variance[i]);
+    ++occupied;
+  }
+  EXPECT_EQ(points.size(), occupied);
+  EXPECT_EQ(cloud.message(common::Stamp(5)).row_step_, occupied * MapCloud::kPointStep);
+
+  msg::PointCloud2 wrong = cloud.message(common::Stamp(5));
+  wrong.point_step_ = 16;
+  EXPECT_THROW(read_map_cloud(wrong), std::runtime_error);
+}
+
+TEST(MapInfo, RoundTripAndInconsistentInfoIsRefused) {
+  MapDescription d;
+  d.resolution = 0.1f;
+  d.block_cells = 8;
+  d.num_classes = 2;
+  d.class_names = {"free", "car"};
+  d.class_colors = {0x000000, 0xff0000};
+  d.min_bound = {-1, -2, -3};
+  d.max_bound = {4, 5, 6};
+  d.num_blocks = 12;
+  d.sequence = 77;
+  const std::string frame = "map";
+  const MapInfoMessage m(d, common::Stamp(3), frame);
+  const MapDescription back = from_msg(m.get());
+  EXPECT_EQ(back.class_names, d.class_names);
+  EXPECT_EQ(back.class_colors, d.class_colors);
+  EXPECT_EQ(back.max_bound, d.max_bound);
+  EXPECT_EQ(back.sequence, 77u);
+
+  d.class_names.push_back("extra");
+  const MapInfoMessage bad(d, common::Stamp(3), frame);
+  EXPECT_THROW(from_msg(bad.get()), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace semap::dds_idl
