@@ -1,0 +1,45 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "semap/common/messages.hpp"
+#include "semap/common/stamp.hpp"
+#include "semap/firmware_bridge/nmea.h"
+#include "semap/firmware_bridge/ubx.h"
+
+namespace semap::firmware_bridge {
+
+struct GnssFixBuilderConfig {
+  // Without GST, horizontal sigma = hdop * uere_m and vertical sigma = 2 * that.
+  double uere_m = 3.0;
+  // A GST from an earlier epoch is reused for this long (accuracy changes slowly).
+  double gst_max_age_s = 1.5;
+};
+
+// Combines the sentences of one NMEA epoch into a GnssFix. The fix is emitted on GGA, with the
+// covariance of the latest GST (same UTC time, or not older than gst_max_age_s) and the velocity
+// of an RMC with the same UTC time or a VTG received since the previous GGA.
+class GnssFixBuilder {
+ public:
+  explicit GnssFixBuilder(const GnssFixBuilderConfig& config = {});
+
+  std::optional<common::GnssFix> add(const SemapNmeaSentence& sentence, common::Stamp stamp);
+
+ private:
+  GnssFixBuilderConfig config_;
+  std::optional<SemapNmeaGst> gst_;
+  common::Stamp gst_stamp_;
+  std::optional<SemapNmeaRmc> rmc_;
+  std::optional<SemapNmeaVtg> vtg_;  // cleared at every GGA
+};
+
+// ENU position covariance from a GST error ellipse (falls back to lat/lon sigmas).
+Eigen::Matrix3d covariance_from_gst(const SemapNmeaGst& gst);
+// ENU velocity from speed over ground and course (deg from true north); vertical is zero.
+Eigen::Vector3d velocity_from_course(double speed_mps, double course_deg);
+// Fix from a UBX NAV-PVT: ellipsoid height, hAcc split equally over east and north, velocity
+// from velN/velE/velD. Invalid when gnssFixOK is clear or the fix type is "none"/"time only".
+common::GnssFix fix_from_nav_pvt(const SemapUbxNavPvt& pvt, common::Stamp stamp);
+
+}  // namespace semap::firmware_bridge

@@ -1,0 +1,96 @@
+#include "semap/firmware_bridge/linux_can.hpp"
+
+#include <linux/can.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+namespace semap::firmware_bridge {
+
+namespace {
+
+[[noreturn]] void fail(int fd, const std::string& interface, const std::string& what) {
+  const int err = errno;
+  if (fd >= 0) ::close(fd);
+  throw std::runtime_error("CAN interface '" + interface + "': " + what + ": " +
+                           std::strerror(err));
+}
+
+}  // namespace
+
+CanSocket::CanSocket(const std::string& interface, bool fd_frames) {
+  if (interface.empty() || interface.size() >= IFNAMSIZ) {
+    throw std::runtime_error("CAN interface name '" + interface + "' is empty or too long");
+  }
+  const int fd = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
+  if (fd < 0) fail(fd, interface, "socket(PF_CAN, SOCK_RAW, CAN_RAW)");
+  ifreq ifr{};
+  std::memcpy(ifr.ifr_name, interface.c_str(), interface.size() + 1);
+  if (::ioctl(fd, SIOCGIFINDEX, &ifr) < 0) fail(fd, interface, "no such interface");
+  if (fd_frames) {
+    const int on = 1;
+    if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on) < 0) {
+      fail(fd, interface, "CAN FD frames not supported");
+    }
+  }
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  addr.can_ifindex = ifr.ifr_ifindex;
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) < 0) {
+    fail(fd, interface, "bind");
+  }
+  fd_ = fd;
+}
+
+CanSocket::~CanSocket() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool write_can_frame(int fd, const SemapCanFrame& frame) {
+  canfd_frame kernel{};
+  kernel.can_id = frame.extended ? ((frame.id & CAN_EFF_MASK) | CAN_EFF_FLAG)
+                                 : (frame.id & CAN_SFF_MASK);
+  const std::size_t max_len = frame.fd ? CANFD_MAX_DLEN : CAN_MAX_DLEN;
+  kernel.len = static_cast<std::uint8_t>(frame.len < max_len ? frame.len : max_len);
+  std::memcpy(kernel.data, frame.data, kernel.len);
+  // struct can_frame is the first CAN_MTU bytes of struct canfd_frame, so one buffer serves both.
+  const std::size_t size = frame.fd ? CANFD_MTU : CAN_MTU;
+  // A full TX queue (ENOBUFS) drains within a few frame times; give it up to ~10 ms.
+  for (int attempt = 0; attempt < 100;) {
+    const ssize_t n = ::write(fd, &kernel, size);
+    if (n == static_cast<ssize_t>(size)) return true;
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == ENOBUFS || errno == EAGAIN)) {
+      const timespec pause{0, 100'000};
+      ::nanosleep(&pause, nullptr);
+      ++attempt;
+      continue;
+    }
+    return false;
+  }
+  return false;
+}
+
+bool from_kernel_frame(const void* bytes, std::size_t size, SemapCanFrame& out) {
+  if (size != CAN_MTU && size != CANFD_MTU) return false;
+  canfd_frame kernel{};
+  std::memcpy(&kernel, bytes, size);
+  if (kernel.can_id & (CAN_RTR_FLAG | CAN_ERR_FLAG)) return false;
+  out = SemapCanFrame{};
+  out.fd = size == CANFD_MTU;
+  out.extended = (kernel.can_id & CAN_EFF_FLAG) != 0;
+  out.id = kernel.can_id & (out.extended ? CAN_EFF_MASK : CAN_SFF_MASK);
+  const std::size_t max_len = out.fd ? CANFD_MAX_DLEN : CAN_MAX_DLEN;
+  out.len = static_cast<std::uint8_t>(kernel.len < max_len ? kernel.len : max_len);
+  std::memcpy(out.data, kernel.data, out.len);
+  return true;
+}
+
+}  // namespace semap::firmware_bridge
