@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "semap/drivers/driver_error.hpp"
+#include "semap/firmware_bridge/linux_can.hpp"
 
 namespace semap::drivers {
 namespace {
@@ -55,8 +56,8 @@ bool interface_is_up(const std::string& interface) {
   return up;
 }
 
-CanSocket::CanSocket(const std::string& interface, std::span<const CanIdFilter> filters,
-                     bool enable_fd)
+CanSocket::CanSocket(const std::string& interface,
+                     std::span<const firmware_bridge::CanIdFilter> filters, bool enable_fd)
     : interface_(interface) {
   if (interface.size() >= IFNAMSIZ) throw DriverError("CAN interface name too long", EINVAL);
   const unsigned int index = ::if_nametoindex(interface.c_str());
@@ -137,11 +138,9 @@ CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {
     if (raw.can_id & CAN_ERR_BUSOFF) throw DriverError(interface_ + ": bus-off", ENETDOWN);
     return CanRead::kTimeout;  // restarted: nothing to deliver
   }
-  frame.extended = (raw.can_id & CAN_EFF_FLAG) != 0;
-  frame.id = raw.can_id & (frame.extended ? CAN_EFF_MASK : CAN_SFF_MASK);
-  frame.fd = got == static_cast<ssize_t>(CANFD_MTU);
-  frame.len = raw.len;
-  std::memcpy(frame.data.data(), raw.data, raw.len);
+  if (!firmware_bridge::from_kernel_frame(&raw, static_cast<std::size_t>(got), frame.frame)) {
+    return CanRead::kTimeout;  // remote frame: not part of any protocol we decode
+  }
   frame.stamp = common::Stamp::now();
   for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPING) {

@@ -1,29 +1,19 @@
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
 
 #include "semap/common/stamp.hpp"
+#include "semap/firmware_bridge/can_frame.h"
+#include "semap/firmware_bridge/can_imu_decoder.hpp"
 
 namespace semap::drivers {
 
 // One received CAN or CAN FD frame with its kernel receive time.
 struct CanRxFrame {
-  std::uint32_t id = 0;  // without the EFF/RTR/ERR flag bits
-  bool extended = false;
-  bool fd = false;
-  std::uint8_t len = 0;
-  std::array<std::uint8_t, 64> data{};
+  SemapCanFrame frame{};
   common::Stamp stamp;  // kernel RX software timestamp, mapped onto CLOCK_MONOTONIC
-};
-
-// Which identifiers to receive: a frame passes when (id & mask) == (filter_id & mask).
-struct CanIdFilter {
-  std::uint32_t id = 0;
-  std::uint32_t mask = 0;
-  bool extended = false;
 };
 
 enum class CanRead : std::uint8_t { kFrame, kTimeout };
@@ -34,7 +24,8 @@ enum class CanRead : std::uint8_t { kFrame, kTimeout };
 // all of them.
 class CanSocket {
  public:
-  CanSocket(const std::string& interface, std::span<const CanIdFilter> filters, bool enable_fd);
+  CanSocket(const std::string& interface, std::span<const firmware_bridge::CanIdFilter> filters,
+            bool enable_fd);
   ~CanSocket();
   CanSocket(const CanSocket&) = delete;
   CanSocket& operator=(const CanSocket&) = delete;
