@@ -21,7 +21,9 @@ firmware_bridge::CanImuCounters CanImuDriver::imu_counters() const {
 
 void CanImuDriver::open_device() {
   const std::array<firmware_bridge::CanIdFilter, 1> filters{decoder_.filter()};
-  socket_ = std::make_unique<CanSocket>(config_.interface, filters, config_.fd_frames);
+  socket_ = std::make_unique<CanSocket>(config_.interface, filters, config_.fd_frames,
+                                        config_.receive_buffer);
+  socket_drops_ = 0;
   log().info("listening on {}", config_.interface);
 }
 
@@ -31,6 +33,10 @@ void CanImuDriver::service_device(std::stop_token /*stop*/) {
   for (int i = 0; i < 64; ++i) {
     if (socket_->receive(i == 0 ? config_.poll_timeout_ms : 0, rx) != CanRead::kFrame) break;
     counters().add_bytes(rx.frame.len);
+    if (rx.kernel_drops > socket_drops_) {
+      counters().add_input_drop(rx.kernel_drops - socket_drops_);
+      socket_drops_ = rx.kernel_drops;
+    }
     if (auto sample = decoder_.push(rx.frame, rx.stamp)) deliver(ring_, std::move(*sample));
   }
   publish_counters();

@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <vector>
 
 #include "semap/drivers/driver_error.hpp"
@@ -25,19 +26,11 @@
 namespace semap::drivers {
 namespace {
 
-// Socket timestamps are CLOCK_REALTIME; the pipeline runs on CLOCK_MONOTONIC. The offset
-// between them is sampled at receive time, microseconds after the kernel stamped the frame.
-common::Stamp realtime_to_monotonic(const timespec& rt) {
-  timespec now_rt{}, now_mono{};
-  ::clock_gettime(CLOCK_REALTIME, &now_rt);
-  ::clock_gettime(CLOCK_MONOTONIC, &now_mono);
-  const std::int64_t offset =
-      common::Stamp::from_timespec(now_rt).ns - common::Stamp::from_timespec(now_mono).ns;
-  return common::Stamp(common::Stamp::from_timespec(rt).ns - offset);
-}
-
-// libsocketcan reports controller state for real CAN hardware; vcan has none (returns error).
+// libsocketcan reports controller state for real CAN hardware. Virtual interfaces (vcan) have
+// no parent device and no state; asking would only make libsocketcan print an error.
 void throw_if_bus_off(const std::string& interface) {
+  std::error_code ec;
+  if (!std::filesystem::exists("/sys/class/net/" + interface + "/device", ec)) return;
   int state = 0;
   if (::can_get_state(interface.c_str(), &state) == 0 && state == CAN_STATE_BUS_OFF) {
     throw DriverError(interface + ": controller is bus-off", ENETDOWN);
@@ -57,7 +50,8 @@ bool interface_is_up(const std::string& interface) {
 }
 
 CanSocket::CanSocket(const std::string& interface,
-                     std::span<const firmware_bridge::CanIdFilter> filters, bool enable_fd)
+                     std::span<const firmware_bridge::CanIdFilter> filters, bool enable_fd,
+                     int receive_buffer)
     : interface_(interface) {
   if (interface.size() >= IFNAMSIZ) throw DriverError("CAN interface name too long", EINVAL);
   const unsigned int index = ::if_nametoindex(interface.c_str());
@@ -90,6 +84,15 @@ CanSocket::CanSocket(const std::string& interface,
         throw_errno(interface + ": CAN_RAW_FD_FRAMES");
       }
     }
+    // FORCE lifts the rmem_max cap when we are privileged; otherwise take what is allowed.
+    if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &receive_buffer, sizeof(receive_buffer)) <
+        0) {
+      ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof(receive_buffer));
+    }
+    const int on = 1;
+    if (::setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof(on)) < 0) {
+      throw_errno(interface + ": SO_RXQ_OVFL");
+    }
     const int ts_flags = SOF_TIMESTAMPING_RX_SOFTWARE | SOF_TIMESTAMPING_SOFTWARE;
     if (::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPING, &ts_flags, sizeof(ts_flags)) < 0) {
       throw_errno(interface + ": SO_TIMESTAMPING");
@@ -119,7 +122,8 @@ CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {
 
   canfd_frame raw{};
   iovec iov{&raw, sizeof(raw)};
-  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(scm_timestamping))];
+  alignas(cmsghdr) char
+      control[CMSG_SPACE(sizeof(scm_timestamping)) + CMSG_SPACE(sizeof(std::uint32_t))];
   msghdr msg{};
   msg.msg_iov = &iov;
   msg.msg_iovlen = 1;
@@ -147,8 +151,10 @@ CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {
       scm_timestamping ts{};
       std::memcpy(&ts, CMSG_DATA(c), sizeof(ts));
       if (ts.ts[0].tv_sec != 0 || ts.ts[0].tv_nsec != 0) {
-        frame.stamp = realtime_to_monotonic(ts.ts[0]);
+        frame.stamp = clock_.convert(ts.ts[0]);
       }
+    } else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+      std::memcpy(&frame.kernel_drops, CMSG_DATA(c), sizeof(frame.kernel_drops));
     }
   }
   return CanRead::kFrame;

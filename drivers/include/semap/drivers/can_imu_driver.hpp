@@ -17,6 +17,7 @@ struct CanImuConfig {
   firmware_bridge::CanImuDecoderConfig decoder;
   bool fd_frames = false;  // accept CAN FD (the semap profile's 64-byte variant)
   int poll_timeout_ms = 100;
+  int receive_buffer = 1 << 20;  // kernel socket queue, bytes
   BackoffConfig backoff;
 };
 
@@ -45,6 +46,7 @@ class CanImuDriver : public DriverRunner {
   common::SpscRing<common::ImuSample>& ring_;
   firmware_bridge::CanImuDecoder decoder_;
   std::unique_ptr<CanSocket> socket_;
+  std::uint32_t socket_drops_ = 0;  // SO_RXQ_OVFL total of the current socket
   firmware_bridge::CanImuCounters published_{};
   mutable std::mutex counters_mutex_;
   firmware_bridge::CanImuCounters shared_counters_{};
