@@ -28,13 +28,13 @@ void semap_can_imu_quantize(const double gyro_rad_s[3], const double accel_mps2[
     const double dps = gyro_rad_s[i] * (180.0 / SEMAP_PI);
     out->gyro[i] =
         (int16_t)semap_round_clamp(dps / SEMAP_CAN_IMU_GYRO_LSB_DPS, -32768, 32767, &gyro_clamped);
-    out->accel[i] = (int16_t)semap_round_clamp(accel_mps2[i] / SEMAP_CAN_IMU_ACCEL_LSB_MPS2,
-                                               -32768, 32767, &accel_clamped);
+    out->accel[i] = (int16_t)semap_round_clamp(accel_mps2[i] / SEMAP_CAN_IMU_ACCEL_LSB_MPS2, -32768,
+                                               32767, &accel_clamped);
   }
   out->timestamp_us = timestamp_us;
   out->sequence = sequence;
-  out->flags = (uint8_t)(extra_flags & ~(SEMAP_CAN_IMU_FLAG_GYRO_SATURATED |
-                                         SEMAP_CAN_IMU_FLAG_ACCEL_SATURATED));
+  out->flags = (uint8_t)(extra_flags &
+                         ~(SEMAP_CAN_IMU_FLAG_GYRO_SATURATED | SEMAP_CAN_IMU_FLAG_ACCEL_SATURATED));
   if (gyro_clamped) out->flags |= SEMAP_CAN_IMU_FLAG_GYRO_SATURATED;
   if (accel_clamped) out->flags |= SEMAP_CAN_IMU_FLAG_ACCEL_SATURATED;
 }
@@ -97,7 +97,8 @@ SemapFbResult semap_can_imu_decode(const SemapCanFrame* frame, uint32_t base_id,
                                    SemapCanImuPart* out) {
   const uint32_t offset = frame->id - base_id; /* wraps to a large value below base */
   if (frame->extended || offset > SEMAP_CAN_IMU_OFFSET_FD) return result(SEMAP_FB_UNKNOWN, -1);
-  const uint8_t expected = offset == SEMAP_CAN_IMU_OFFSET_FD ? SEMAP_CANFD_MAX_DLEN : SEMAP_CLASSIC_LEN;
+  const uint8_t expected =
+      offset == SEMAP_CAN_IMU_OFFSET_FD ? SEMAP_CANFD_MAX_DLEN : SEMAP_CLASSIC_LEN;
   if (frame->len < expected) return result(SEMAP_FB_TRUNCATED, -1);
   if (frame->len > expected) return result(SEMAP_FB_TOO_LONG, -1);
   if (frame_crc(frame->id, frame->data, expected - 1u) != frame->data[expected - 1u]) {

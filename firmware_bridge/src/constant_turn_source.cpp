@@ -20,8 +20,8 @@ common::Stamp stamp_at(common::Stamp start, std::uint64_t index, double rate_hz)
 ConstantTurnSource::ConstantTurnSource(const ConstantTurnConfig& config)
     : config_(config),
       imu_count_(static_cast<std::uint64_t>(std::floor(config.duration_s * config.imu_rate_hz))),
-      gnss_count_(
-          static_cast<std::uint64_t>(std::floor(config.duration_s * config.gnss_rate_hz))) {}
+      gnss_count_(static_cast<std::uint64_t>(std::floor(config.duration_s * config.gnss_rate_hz))) {
+}
 
 common::ImuSample ConstantTurnSource::imu_at(std::uint64_t index) const {
   common::ImuSample s;
@@ -66,9 +66,8 @@ common::GnssFix ConstantTurnSource::gnss_at(std::uint64_t index) const {
 std::optional<SensorEvent> ConstantTurnSource::next() {
   const bool has_imu = imu_index_ < imu_count_;
   const bool has_gnss = gnss_index_ < gnss_count_;
-  if (has_imu &&
-      (!has_gnss || stamp_at(config_.start, imu_index_, config_.imu_rate_hz) <=
-                        stamp_at(config_.start, gnss_index_, config_.gnss_rate_hz))) {
+  if (has_imu && (!has_gnss || stamp_at(config_.start, imu_index_, config_.imu_rate_hz) <=
+                                   stamp_at(config_.start, gnss_index_, config_.gnss_rate_hz))) {
     return imu_at(imu_index_++);
   }
   if (has_gnss) return gnss_at(gnss_index_++);

@@ -59,9 +59,8 @@ void Emulator::run(SensorSource& source, const std::atomic<bool>* stop) {
       }
       const auto offset_ns = static_cast<std::int64_t>(
           static_cast<double>(stamp.ns - first_stamp_.ns) / config_.speed);
-      const timespec target = common::Stamp(common::Stamp::from_timespec(wall_start).ns +
-                                            offset_ns)
-                                  .to_timespec();
+      const timespec target =
+          common::Stamp(common::Stamp::from_timespec(wall_start).ns + offset_ns).to_timespec();
       while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &target, nullptr) == EINTR) {
       }
     }
@@ -135,8 +134,7 @@ void Emulator::emit_imu(const common::ImuSample& sample) {
     semap_j1939_encode_angular_rate(&rate, 2, config_.j1939_source, &frames[0]);
     semap_j1939_encode_acceleration(&acc, 2, config_.j1939_source, &frames[1]);
   }
-  const auto victim =
-      std::uniform_int_distribution<std::size_t>(0, frames.size() - 1)(rng_);
+  const auto victim = std::uniform_int_distribution<std::size_t>(0, frames.size() - 1)(rng_);
   if (fault == CanFault::kCrc) {
     SemapCanFrame& frame = frames[victim];
     frame.data[frame.len - 1] ^= static_cast<std::uint8_t>(1u << (rng_() % 8));
@@ -228,8 +226,8 @@ void Emulator::emit_gnss(const common::GnssFix& truth) {
     const std::vector<std::uint8_t> frame = encode_ubx_epoch(fix, utc_ms);
     if (truncate) {
       // Keep the complete header so the receiver reads the length, then lose the tail.
-      const std::size_t keep = std::uniform_int_distribution<std::size_t>(
-          SEMAP_UBX_HEADER_LEN, frame.size() - 1)(rng_);
+      const std::size_t keep =
+          std::uniform_int_distribution<std::size_t>(SEMAP_UBX_HEADER_LEN, frame.size() - 1)(rng_);
       send_serial(frame.data(), keep);
       ++stats_.injected.truncated;
     } else {

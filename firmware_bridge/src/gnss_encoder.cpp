@@ -101,8 +101,8 @@ void ellipse_from_covariance(const Eigen::Matrix3d& c, SemapNmeaGst& gst) {
 std::vector<std::string> encode_nmea_epoch(const common::GnssFix& fix, std::int64_t utc_unix_ms,
                                            SemapNmeaTalker talker) {
   const CivilTime t = civil_from_unix_ms(utc_unix_ms);
-  const auto time_ms = static_cast<std::int32_t>(((t.hour * 60 + t.minute) * 60 + t.second) * 1000 +
-                                                 t.millisecond);
+  const auto time_ms =
+      static_cast<std::int32_t>(((t.hour * 60 + t.minute) * 60 + t.second) * 1000 + t.millisecond);
   const bool valid = fix.valid();
   const Eigen::Matrix3d& c = fix.covariance;
   std::vector<std::string> out;

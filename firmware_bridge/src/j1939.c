@@ -45,8 +45,8 @@ static int get_scaled(const uint8_t* p, double lsb, double offset, double* out) 
 
 static void put_scaled(uint8_t* p, double value, double lsb, double offset) {
   int clamped = 0;
-  semap_put_u16(p, (uint16_t)semap_round_clamp((value - offset) / lsb, 0,
-                                               SEMAP_J1939_MAX_VALID_U16, &clamped));
+  semap_put_u16(p, (uint16_t)semap_round_clamp((value - offset) / lsb, 0, SEMAP_J1939_MAX_VALID_U16,
+                                               &clamped));
 }
 
 SemapFbResult semap_j1939_decode_angular_rate(const uint8_t* data, uint8_t len,
@@ -118,9 +118,9 @@ void semap_j1939_encode_acceleration(const SemapJ1939Acceleration* in, uint8_t p
              SEMAP_J1939_ACCEL_OFFSET_MPS2);
   put_scaled(out->data + 4, in->vertical_mps2, SEMAP_J1939_ACCEL_LSB_MPS2,
              SEMAP_J1939_ACCEL_OFFSET_MPS2);
-  out->data[6] = (uint8_t)(0xC0u | (in->lateral_fom & 0x03u) |
-                           ((in->longitudinal_fom & 0x03u) << 2) |
-                           ((in->vertical_fom & 0x03u) << 4));
+  out->data[6] =
+      (uint8_t)(0xC0u | (in->lateral_fom & 0x03u) | ((in->longitudinal_fom & 0x03u) << 2) |
+                ((in->vertical_fom & 0x03u) << 4));
   out->data[7] = 0xFFu;
 }
 

@@ -55,8 +55,8 @@ CanSocket::~CanSocket() {
 
 bool write_can_frame(int fd, const SemapCanFrame& frame) {
   canfd_frame kernel{};
-  kernel.can_id = frame.extended ? ((frame.id & CAN_EFF_MASK) | CAN_EFF_FLAG)
-                                 : (frame.id & CAN_SFF_MASK);
+  kernel.can_id =
+      frame.extended ? ((frame.id & CAN_EFF_MASK) | CAN_EFF_FLAG) : (frame.id & CAN_SFF_MASK);
   const std::size_t max_len = frame.fd ? CANFD_MAX_DLEN : CAN_MAX_DLEN;
   kernel.len = static_cast<std::uint8_t>(frame.len < max_len ? frame.len : max_len);
   std::memcpy(kernel.data, frame.data, kernel.len);

@@ -6,9 +6,8 @@
 #include <stdint.h>
 
 /* Powers of ten that are exact doubles, so one division rounds correctly. */
-static const double kSemapPow10[19] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,
-                                       1e7,  1e8,  1e9,  1e10, 1e11, 1e12, 1e13,
-                                       1e14, 1e15, 1e16, 1e17, 1e18};
+static const double kSemapPow10[19] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8, 1e9,
+                                       1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18};
 
 /* [+-]digits[.digits] with at least one and at most 18 digits; returns 0 when malformed. */
 static inline int semap_nmea_parse_decimal(const char* s, size_t n, double* out) {

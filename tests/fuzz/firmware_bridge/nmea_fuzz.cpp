@@ -1,0 +1,38 @@
+// NMEA parser: any bytes must give a status, never a crash; an accepted sentence must survive
+// encode -> parse with the same type.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+
+#include "semap/firmware_bridge/nmea.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  SemapNmeaSentence s;
+  const SemapFbResult r = semap_nmea_parse(reinterpret_cast<const char*>(data), size, &s);
+  if (r.status >= SEMAP_FB_STATUS_COUNT) std::abort();
+  if (r.status != SEMAP_FB_OK) return 0;
+  char buf[SEMAP_NMEA_MAX_LENGTH + 1];
+  std::size_t n = 0;
+  switch (s.type) {
+    case SEMAP_NMEA_GGA:
+      n = semap_nmea_encode_gga(&s.u.gga, s.talker, buf, sizeof buf);
+      break;
+    case SEMAP_NMEA_RMC:
+      n = semap_nmea_encode_rmc(&s.u.rmc, s.talker, buf, sizeof buf);
+      break;
+    case SEMAP_NMEA_GST:
+      n = semap_nmea_encode_gst(&s.u.gst, s.talker, buf, sizeof buf);
+      break;
+    case SEMAP_NMEA_VTG:
+      n = semap_nmea_encode_vtg(&s.u.vtg, s.talker, buf, sizeof buf);
+      break;
+  }
+  // Re-encoding may not fit in 82 chars (more decimals than the input had): then n == 0.
+  if (n > SEMAP_NMEA_MAX_LENGTH) std::abort();
+  if (n > 0) {
+    SemapNmeaSentence again;
+    const SemapFbResult r2 = semap_nmea_parse(buf, n, &again);
+    if (r2.status == SEMAP_FB_OK && again.type != s.type) std::abort();
+  }
+  return 0;
+}
