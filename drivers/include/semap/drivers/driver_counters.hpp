@@ -1,0 +1,61 @@
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+namespace semap::drivers {
+
+// A consistent-enough copy of a driver's counters for reporting.
+struct DriverStats {
+  std::uint64_t frames = 0;             // messages delivered into the ring
+  std::uint64_t bytes = 0;              // bytes read from the kernel
+  std::uint64_t checksum_failures = 0;  // CRC / NMEA / UBX / JPEG integrity failures
+  std::uint64_t sequence_gaps = 0;      // messages missing according to sequence counters
+  std::uint64_t ring_drops = 0;         // messages lost because the consumer fell behind
+  std::uint64_t input_drops = 0;        // messages the kernel dropped before we read them
+  std::uint64_t reconnects = 0;         // successful reopenings after a failure
+  std::uint64_t errors = 0;             // other rejected input (malformed, unexpected)
+};
+
+// Written by the driver thread only, read from any thread. Single writer, so a relaxed load
+// plus a release store is enough and avoids locked instructions in the receive path.
+class DriverCounters {
+ public:
+  void add_frame(std::uint64_t n = 1) { bump(frames_, n); }
+  void add_bytes(std::uint64_t n) { bump(bytes_, n); }
+  void add_checksum_failure(std::uint64_t n = 1) { bump(checksum_failures_, n); }
+  void add_sequence_gap(std::uint64_t n) { bump(sequence_gaps_, n); }
+  void add_ring_drop(std::uint64_t n = 1) { bump(ring_drops_, n); }
+  void add_input_drop(std::uint64_t n) { bump(input_drops_, n); }
+  void add_reconnect() { bump(reconnects_, 1); }
+  void add_error(std::uint64_t n = 1) { bump(errors_, n); }
+
+  DriverStats snapshot() const {
+    DriverStats s;
+    s.frames = frames_.load(std::memory_order_acquire);
+    s.bytes = bytes_.load(std::memory_order_acquire);
+    s.checksum_failures = checksum_failures_.load(std::memory_order_acquire);
+    s.sequence_gaps = sequence_gaps_.load(std::memory_order_acquire);
+    s.ring_drops = ring_drops_.load(std::memory_order_acquire);
+    s.input_drops = input_drops_.load(std::memory_order_acquire);
+    s.reconnects = reconnects_.load(std::memory_order_acquire);
+    s.errors = errors_.load(std::memory_order_acquire);
+    return s;
+  }
+
+ private:
+  static void bump(std::atomic<std::uint64_t>& c, std::uint64_t n) {
+    c.store(c.load(std::memory_order_relaxed) + n, std::memory_order_release);
+  }
+
+  std::atomic<std::uint64_t> frames_{0};
+  std::atomic<std::uint64_t> bytes_{0};
+  std::atomic<std::uint64_t> checksum_failures_{0};
+  std::atomic<std::uint64_t> sequence_gaps_{0};
+  std::atomic<std::uint64_t> ring_drops_{0};
+  std::atomic<std::uint64_t> input_drops_{0};
+  std::atomic<std::uint64_t> reconnects_{0};
+  std::atomic<std::uint64_t> errors_{0};
+};
+
+}  // namespace semap::drivers

@@ -1,0 +1,25 @@
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core/mat.hpp>
+#include <optional>
+
+#include "semap/common/messages.hpp"
+
+namespace semap::drivers {
+
+class JpegDecoder;
+
+// V4L2 fourcc of a pipeline pixel format, and back (nullopt for formats the pipeline lacks).
+std::uint32_t to_fourcc(common::PixelFormat format);
+std::optional<common::PixelFormat> from_fourcc(std::uint32_t fourcc);
+
+// Converts a captured frame to an OpenCV image: YUYV and MJPEG to CV_8UC3 BGR, GREY to
+// CV_8UC1, Z16 to CV_16UC1 (depth units as the device reports them). Raw formats are copied
+// out of the frame; an empty Mat means the frame is truncated or the JPEG is corrupt.
+cv::Mat to_mat(const common::ImageFrame& frame, JpegDecoder& jpeg);
+
+// Bytes a complete raw frame needs (stride * height); 0 for compressed formats.
+std::size_t expected_size(const common::ImageFrame& frame);
+
+}  // namespace semap::drivers

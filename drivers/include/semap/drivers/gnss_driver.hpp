@@ -1,0 +1,54 @@
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/drivers/driver_runner.hpp"
+#include "semap/drivers/serial_port.hpp"
+#include "semap/firmware_bridge/gnss_stream_decoder.hpp"
+
+namespace semap::drivers {
+
+struct GnssConfig {
+  SerialConfig serial;
+  firmware_bridge::GnssFixBuilderConfig fix;
+  int poll_timeout_ms = 100;
+  BackoffConfig backoff;
+};
+
+// Serial GNSS thread: termios raw 8N1, poll()-based reads, NMEA and UBX (interleaved) through
+// the firmware_bridge framer, which resynchronises after garbage; fixes are stamped with the
+// read time (CLOCK_MONOTONIC). EIO/ENODEV/hang-up: reported and reopened with backoff; the
+// decoder starts afresh on the new connection (a half sentence from before is discarded).
+class GnssDriver : public DriverRunner {
+ public:
+  GnssDriver(GnssConfig config, common::SpscRing<common::GnssFix>& ring);
+  ~GnssDriver() override;
+
+  // Per-kind counters summed over every connection.
+  firmware_bridge::GnssStreamCounters stream_counters() const;
+
+ protected:
+  void open_device() override;
+  void service_device(std::stop_token stop) override;
+  void close_device() noexcept override;
+
+ private:
+  void publish_counters();
+
+  GnssConfig config_;
+  common::SpscRing<common::GnssFix>& ring_;
+  std::unique_ptr<SerialPort> port_;
+  std::unique_ptr<firmware_bridge::GnssStreamDecoder> decoder_;
+  std::vector<common::GnssFix> fixes_;
+  std::vector<std::uint8_t> buffer_;
+  firmware_bridge::GnssStreamCounters closed_{};     // sums of earlier connections
+  firmware_bridge::GnssStreamCounters published_{};  // totals at the last publish
+  mutable std::mutex counters_mutex_;
+  firmware_bridge::GnssStreamCounters shared_counters_{};
+};
+
+}  // namespace semap::drivers

@@ -1,0 +1,95 @@
+#include "semap/drivers/driver_runner.hpp"
+
+#include <condition_variable>
+#include <exception>
+
+#include "semap/common/logging.hpp"
+
+namespace semap::drivers {
+namespace {
+
+// Sleeps for `delay` unless a stop is requested first; returns false when stopping.
+bool wait_unless_stopped(std::stop_token stop, std::chrono::milliseconds delay) {
+  std::mutex mutex;
+  std::condition_variable_any cv;
+  std::unique_lock lock(mutex);
+  return !cv.wait_for(lock, stop, delay, [] { return false; }) && !stop.stop_requested();
+}
+
+}  // namespace
+
+const char* to_string(DriverState state) {
+  switch (state) {
+    case DriverState::kStopped:
+      return "stopped";
+    case DriverState::kConnecting:
+      return "connecting";
+    case DriverState::kRunning:
+      return "running";
+    case DriverState::kReconnecting:
+      return "reconnecting";
+  }
+  return "unknown";
+}
+
+DriverRunner::DriverRunner(std::string name, BackoffConfig backoff)
+    : name_(std::move(name)), backoff_config_(backoff), log_(common::logger(name_)) {
+  Backoff check(backoff);  // validates the configuration before any thread starts
+}
+
+DriverRunner::~DriverRunner() { stop(); }
+
+void DriverRunner::start() {
+  if (thread_.joinable()) return;
+  state_.store(DriverState::kConnecting, std::memory_order_release);
+  thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+}
+
+void DriverRunner::stop() {
+  if (!thread_.joinable()) return;
+  thread_.request_stop();
+  thread_.join();
+  state_.store(DriverState::kStopped, std::memory_order_release);
+}
+
+std::string DriverRunner::last_error() const {
+  std::lock_guard lock(error_mutex_);
+  return last_error_;
+}
+
+void DriverRunner::report(const std::string& message) {
+  log_->warn("{}", message);
+  std::lock_guard lock(error_mutex_);
+  last_error_ = message;
+}
+
+void DriverRunner::run(std::stop_token stop) {
+  Backoff backoff(backoff_config_);
+  bool ever_connected = false;
+  while (!stop.stop_requested()) {
+    try {
+      open_device();
+      if (ever_connected) {
+        counters_.add_reconnect();
+        log_->info("reconnected after {} attempt(s)", backoff.attempts());
+      }
+      ever_connected = true;
+      backoff.reset();
+      state_.store(DriverState::kRunning, std::memory_order_release);
+      while (!stop.stop_requested()) service_device(stop);
+      close_device();
+      break;
+    } catch (const std::exception& e) {
+      // Any failure of the device, including ones thrown by decoders, ends this connection;
+      // the thread survives and retries, so one bad device never takes the pipeline down.
+      failures_.store(failures_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+      report(e.what());
+      close_device();
+      state_.store(ever_connected ? DriverState::kReconnecting : DriverState::kConnecting,
+                   std::memory_order_release);
+      if (!wait_unless_stopped(stop, backoff.next())) break;
+    }
+  }
+}
+
+}  // namespace semap::drivers

@@ -1,0 +1,80 @@
+#include "semap/drivers/frame_convert.hpp"
+
+#include <linux/videodev2.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "semap/drivers/jpeg_decoder.hpp"
+
+namespace semap::drivers {
+
+using common::PixelFormat;
+
+std::uint32_t to_fourcc(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kYuyv:
+      return V4L2_PIX_FMT_YUYV;
+    case PixelFormat::kMjpeg:
+      return V4L2_PIX_FMT_MJPEG;
+    case PixelFormat::kGrey:
+      return V4L2_PIX_FMT_GREY;
+    case PixelFormat::kZ16:
+      return V4L2_PIX_FMT_Z16;
+    case PixelFormat::kBgr24:
+      return V4L2_PIX_FMT_BGR24;
+  }
+  return 0;
+}
+
+std::optional<PixelFormat> from_fourcc(std::uint32_t fourcc) {
+  switch (fourcc) {
+    case V4L2_PIX_FMT_YUYV:
+      return PixelFormat::kYuyv;
+    case V4L2_PIX_FMT_MJPEG:
+    case V4L2_PIX_FMT_JPEG:
+      return PixelFormat::kMjpeg;
+    case V4L2_PIX_FMT_GREY:
+      return PixelFormat::kGrey;
+    case V4L2_PIX_FMT_Z16:
+      return PixelFormat::kZ16;
+    case V4L2_PIX_FMT_BGR24:
+      return PixelFormat::kBgr24;
+    default:
+      return std::nullopt;
+  }
+}
+
+std::size_t expected_size(const common::ImageFrame& frame) {
+  if (frame.format == PixelFormat::kMjpeg) return 0;
+  return static_cast<std::size_t>(frame.stride) * frame.height;
+}
+
+cv::Mat to_mat(const common::ImageFrame& frame, JpegDecoder& jpeg) {
+  if (frame.format == PixelFormat::kMjpeg) return jpeg.decode_bgr(frame.data);
+  if (frame.width == 0 || frame.height == 0 || frame.data.size() < expected_size(frame)) {
+    return {};
+  }
+  // cv::Mat views the frame's bytes with its stride; the conversions below copy.
+  auto* data = const_cast<std::uint8_t*>(frame.data.data());
+  const int rows = static_cast<int>(frame.height);
+  const int cols = static_cast<int>(frame.width);
+  switch (frame.format) {
+    case PixelFormat::kYuyv: {
+      const cv::Mat yuyv(rows, cols, CV_8UC2, data, frame.stride);
+      cv::Mat bgr;
+      cv::cvtColor(yuyv, bgr, cv::COLOR_YUV2BGR_YUYV);
+      return bgr;
+    }
+    case PixelFormat::kGrey:
+      return cv::Mat(rows, cols, CV_8UC1, data, frame.stride).clone();
+    case PixelFormat::kZ16:
+      return cv::Mat(rows, cols, CV_16UC1, data, frame.stride).clone();
+    case PixelFormat::kBgr24:
+      return cv::Mat(rows, cols, CV_8UC3, data, frame.stride).clone();
+    case PixelFormat::kMjpeg:
+      break;
+  }
+  return {};
+}
+
+}  // namespace semap::drivers

@@ -1,0 +1,263 @@
+// CanImuDriver against the firmware emulator on a real vcan0: natively where the host kernel
+// can create vcan0, otherwise inside scripts/hil-qemu (see docs/hil.md).
+#include <net/if.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hil_env.hpp"
+#include "semap/drivers/can_imu_driver.hpp"
+#include "semap/firmware_bridge/constant_turn_source.hpp"
+#include "semap/firmware_bridge/emulator.hpp"
+#include "semap/firmware_bridge/linux_can.hpp"
+
+namespace semap::drivers {
+namespace {
+
+using common::ImuSample;
+using common::SpscRing;
+using namespace std::chrono_literals;
+
+constexpr const char* kInterface = "vcan0";
+
+// SIOCSIFFLAGS, as `ip link set vcan0 up/down` does.
+bool set_link_up(const char* name, bool up) {
+  const int s = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (s < 0) return false;
+  ifreq ifr{};
+  std::strncpy(ifr.ifr_name, name, IFNAMSIZ - 1);
+  bool ok = ::ioctl(s, SIOCGIFFLAGS, &ifr) == 0;
+  if (ok) {
+    ifr.ifr_flags = static_cast<short>(up ? (ifr.ifr_flags | IFF_UP) : (ifr.ifr_flags & ~IFF_UP));
+    ok = ::ioctl(s, SIOCSIFFLAGS, &ifr) == 0;
+  }
+  ::close(s);
+  return ok;
+}
+
+// vcan0 exists and is up, creating it when the kernel allows (root with the vcan module).
+bool ensure_vcan() {
+  if (::if_nametoindex(kInterface) == 0) {
+    const char* ip = std::getenv("SEMAP_HIL_IP");
+    const std::string cmd =
+        std::string(ip ? ip : "ip") + " link add dev " + kInterface + " type vcan 2>/dev/null";
+    if (std::system(cmd.c_str()) != 0 || ::if_nametoindex(kInterface) == 0) return false;
+  }
+  return set_link_up(kInterface, true);
+}
+
+struct Received {
+  std::vector<ImuSample> samples;
+};
+
+class VcanTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!ensure_vcan()) SEMAP_HIL_UNAVAILABLE("cannot create vcan0 on this kernel");
+  }
+
+  static CanImuConfig config() {
+    CanImuConfig c;
+    c.interface = kInterface;
+    c.backoff.initial = 10ms;
+    c.backoff.max = 50ms;
+    return c;
+  }
+
+  static firmware_bridge::ConstantTurnConfig truth(double seconds) {
+    firmware_bridge::ConstantTurnConfig t;
+    t.duration_s = seconds;
+    t.imu_rate_hz = 400.0;
+    t.gnss_rate_hz = 1.0;  // not sent: no serial fd
+    return t;
+  }
+
+  static firmware_bridge::EmulatorConfig emulator_config(int fd, double speed) {
+    firmware_bridge::EmulatorConfig ec;
+    ec.can_fd = fd;
+    ec.speed = speed;
+    return ec;
+  }
+
+  // Consumer thread standing in for the estimator: pops until told to stop.
+  void start_consumer(SpscRing<ImuSample>& ring) {
+    consumer_ = std::jthread([this, &ring](std::stop_token stop) {
+      ImuSample s;
+      while (!stop.stop_requested()) {
+        while (ring.try_pop(s)) received_.samples.push_back(s);
+        std::this_thread::sleep_for(1ms);
+      }
+      while (ring.try_pop(s)) received_.samples.push_back(s);
+    });
+  }
+  void stop_consumer() {
+    consumer_.request_stop();
+    consumer_.join();
+  }
+
+  Received received_;
+  std::jthread consumer_;
+};
+
+TEST_F(VcanTest, Receives400HzFor10sWithoutLossCrcErrorsOrGaps) {
+  SpscRing<ImuSample> ring(4096, common::OverflowPolicy::kDropOldest);
+  CanImuDriver driver(config(), ring);
+  driver.start();
+  ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s))
+      << driver.last_error();
+  start_consumer(ring);
+
+  firmware_bridge::CanSocket tx(kInterface, false);
+  firmware_bridge::Emulator emulator(emulator_config(tx.fd(), 1.0));
+  firmware_bridge::ConstantTurnSource source(truth(10.0));
+  emulator.run(source);
+  const auto sent = emulator.stats();
+  EXPECT_TRUE(hil::wait_until([&] { return driver.stats().frames >= sent.imu_samples; }, 5s));
+  driver.stop();
+  stop_consumer();
+
+  const auto c = driver.imu_counters();
+  const auto& got = received_.samples;
+  std::printf(
+      "vcan clean: sent %llu samples (%llu frames, %llu write failures), received %zu, "
+      "CRC errors %llu, gaps %llu (missed %llu), ring drops %llu, kernel drops %llu\n",
+      (unsigned long long)sent.imu_samples, (unsigned long long)sent.can_frames,
+      (unsigned long long)sent.can_write_failures, got.size(), (unsigned long long)c.crc_errors,
+      (unsigned long long)c.sequence_gaps, (unsigned long long)c.missed_samples,
+      (unsigned long long)driver.stats().ring_drops,
+      (unsigned long long)driver.stats().input_drops);
+  EXPECT_EQ(sent.imu_samples, 4000u);
+  EXPECT_EQ(sent.can_write_failures, 0u);
+  ASSERT_EQ(got.size(), sent.imu_samples);
+  EXPECT_EQ(c.crc_errors, 0u);
+  EXPECT_EQ(c.sequence_gaps, 0u);
+  EXPECT_EQ(c.incomplete, 0u);
+  EXPECT_EQ(driver.stats().ring_drops, 0u);
+  EXPECT_EQ(driver.stats().input_drops, 0u);
+  EXPECT_EQ(driver.stats().bytes, sent.can_frames * 8);
+  for (std::size_t i = 1; i < got.size(); ++i) {
+    ASSERT_EQ(got[i].sequence, got[i - 1].sequence + 1) << i;
+    ASSERT_GT(got[i].stamp, got[i - 1].stamp) << i;
+  }
+  // Kernel receive stamps are on CLOCK_MONOTONIC: 10 s of samples span about 10 s of it.
+  const double span = common::seconds_between(got.back().stamp, got.front().stamp);
+  EXPECT_NEAR(span, 9.9975, 0.5);
+  EXPECT_LT(common::seconds_between(common::Stamp::now(), got.back().stamp), 10.0);
+  EXPECT_GE(common::seconds_between(common::Stamp::now(), got.back().stamp), 0.0);
+}
+
+TEST_F(VcanTest, CountsInjectedCrcErrorsDropsAndGapsExactly) {
+  SpscRing<ImuSample> ring(4096, common::OverflowPolicy::kDropOldest);
+  CanImuDriver driver(config(), ring);
+  driver.start();
+  ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
+  start_consumer(ring);
+
+  firmware_bridge::CanSocket tx(kInterface, false);
+  auto ec = emulator_config(tx.fd(), 2.0);
+  ec.faults.crc_error = 0.02;
+  ec.faults.drop_frame = 0.01;
+  ec.faults.sequence_gap = 0.01;
+  ec.faults.seed = 3;
+  firmware_bridge::Emulator emulator(ec);
+  firmware_bridge::ConstantTurnSource source(truth(4.0));
+  emulator.run(source);
+  // Clean samples after the run, so a fault in the last sample is detected too.
+  emulator.set_faults({});
+  for (int i = 1; i <= 3; ++i) {
+    ImuSample tail;
+    tail.stamp = truth(4.0).start + (4.0 + i / 400.0);
+    emulator.emit(tail);
+  }
+  const auto sent = emulator.stats();
+  const auto& inj = sent.injected;
+  const std::uint64_t lost = inj.crc_errors + inj.dropped_frames;
+  ASSERT_TRUE(hil::wait_until(
+      [&] { return driver.imu_counters().samples >= sent.imu_samples - lost; }, 5s));
+  std::this_thread::sleep_for(50ms);
+  driver.stop();
+  stop_consumer();
+
+  const auto c = driver.imu_counters();
+  const auto stats = driver.stats();
+  std::printf(
+      "vcan faults: sent %llu samples; injected CRC %llu, dropped frames %llu, gaps %llu; "
+      "counted CRC %llu, incomplete %llu, sequence gaps %llu, missed samples %llu; "
+      "received %zu\n",
+      (unsigned long long)sent.imu_samples, (unsigned long long)inj.crc_errors,
+      (unsigned long long)inj.dropped_frames, (unsigned long long)inj.sequence_gaps,
+      (unsigned long long)c.crc_errors, (unsigned long long)c.incomplete,
+      (unsigned long long)c.sequence_gaps, (unsigned long long)c.missed_samples,
+      received_.samples.size());
+  ASSERT_GT(inj.crc_errors, 0u);
+  ASSERT_GT(inj.dropped_frames, 0u);
+  ASSERT_GT(inj.sequence_gaps, 0u);
+  EXPECT_EQ(c.crc_errors, inj.crc_errors);
+  EXPECT_EQ(c.incomplete, inj.crc_errors + inj.dropped_frames);
+  EXPECT_EQ(c.missed_samples, inj.crc_errors + inj.dropped_frames + inj.sequence_gaps);
+  EXPECT_EQ(received_.samples.size(), sent.imu_samples - lost);
+  EXPECT_EQ(c.samples, received_.samples.size());
+  EXPECT_EQ(stats.checksum_failures, c.crc_errors);
+  EXPECT_EQ(stats.sequence_gaps, c.missed_samples);
+  // Every sample the sensor made is either delivered or counted as missed.
+  EXPECT_EQ(received_.samples.back().sequence - received_.samples.front().sequence + 1,
+            received_.samples.size() + c.missed_samples);
+}
+
+TEST_F(VcanTest, ResumesAfterInterfaceDownAndUp) {
+  SpscRing<ImuSample> ring(4096, common::OverflowPolicy::kDropOldest);
+  CanImuDriver driver(config(), ring);
+  driver.start();
+  ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
+  start_consumer(ring);
+
+  firmware_bridge::CanSocket tx(kInterface, false);
+  firmware_bridge::Emulator emulator(emulator_config(tx.fd(), 1.0));
+  firmware_bridge::ConstantTurnSource source(truth(3.0));
+  std::jthread sender([&] { emulator.run(source); });
+
+  ASSERT_TRUE(hil::wait_until([&] { return driver.stats().frames >= 400; }, 5s));
+  ASSERT_TRUE(set_link_up(kInterface, false));
+  const bool reported = hil::wait_until([&] { return driver.failures() > 0; }, 2s);
+  std::this_thread::sleep_for(150ms);  // the driver's reopen attempts find it down
+  const DriverState while_down = driver.state();
+  const std::uint64_t frames_while_down = driver.stats().frames;
+  ASSERT_TRUE(set_link_up(kInterface, true));
+  sender.join();
+  ASSERT_TRUE(hil::wait_until([&] { return driver.stats().reconnects == 1; }, 2s))
+      << driver.last_error();
+  std::this_thread::sleep_for(50ms);
+  driver.stop();
+  stop_consumer();
+
+  const auto c = driver.imu_counters();
+  const auto sent = emulator.stats();
+  const auto& got = received_.samples;
+  std::printf(
+      "vcan down/up: sent %llu samples (%llu frame writes failed while down), received "
+      "%zu, missed %llu, failures %llu, reconnects %llu, last error '%s'\n",
+      (unsigned long long)sent.imu_samples, (unsigned long long)sent.can_write_failures, got.size(),
+      (unsigned long long)c.missed_samples, (unsigned long long)driver.failures(),
+      (unsigned long long)driver.stats().reconnects, driver.last_error().c_str());
+  EXPECT_TRUE(reported);
+  EXPECT_NE(while_down, DriverState::kRunning);
+  EXPECT_NE(driver.last_error().find("down"), std::string::npos) << driver.last_error();
+  EXPECT_GT(sent.can_write_failures, 0u);
+  // It resumed: samples after the outage arrived, up to the emulator's last one.
+  ASSERT_FALSE(got.empty());
+  EXPECT_GT(got.size(), frames_while_down + 400);
+  EXPECT_EQ(got.back().sequence, 1199u);
+  EXPECT_EQ(got.back().sequence - got.front().sequence + 1, got.size() + c.missed_samples);
+  EXPECT_EQ(c.crc_errors, 0u);
+}
+
+}  // namespace
+}  // namespace semap::drivers

@@ -1,0 +1,57 @@
+#include "semap/drivers/driver_config.hpp"
+
+#include <gtest/gtest.h>
+
+namespace semap::drivers {
+namespace {
+
+using common::ConfigError;
+using common::ConfigSection;
+
+TEST(DriverConfig, ReadsTheOnboardShape) {
+  const auto root = ConfigSection::load_string(R"(
+imu: { interface: vcan0, profile: j1939, j1939_source: 128, rate_hz: 400, ring: 4096 }
+gnss: { device: /dev/ttyUSB1, baud: 230400, reconnect_min_ms: 10, reconnect_max_ms: 500 }
+camera: { device: /dev/video2, format: GREY, width: 320, height: 240, fps: 15 }
+)",
+                                               "onboard.yaml");
+  const auto imu = can_imu_config(root.section("imu"));
+  EXPECT_EQ(imu.interface, "vcan0");
+  EXPECT_EQ(imu.decoder.profile, firmware_bridge::ImuProfile::kJ1939);
+  EXPECT_EQ(imu.decoder.j1939_source, 128);
+  const auto gnss = gnss_config(root.section("gnss"));
+  EXPECT_EQ(gnss.serial.device, "/dev/ttyUSB1");
+  EXPECT_EQ(gnss.serial.baud, 230400);
+  EXPECT_EQ(gnss.backoff.initial.count(), 10);
+  EXPECT_EQ(gnss.backoff.max.count(), 500);
+  const auto cam = camera_config(root.section("camera"));
+  EXPECT_EQ(cam.format, common::PixelFormat::kGrey);
+  EXPECT_EQ(cam.width, 320u);
+  EXPECT_DOUBLE_EQ(cam.fps, 15.0);
+}
+
+TEST(DriverConfig, LeavesOtherKeysToTheCallersFinish) {
+  const auto root =
+      ConfigSection::load_string("imu: { interface: can0, ring: 4096, typo_key: 1 }\n", "x.yaml");
+  const auto imu = root.section("imu");
+  can_imu_config(imu);
+  imu.get<int>("ring");
+  EXPECT_THROW(imu.finish(), ConfigError);  // typo_key was read by nobody
+}
+
+TEST(DriverConfig, RejectsBadValuesNamingTheFile) {
+  const auto bad_baud = ConfigSection::load_string("gnss: { baud: 12345 }\n", "gnss.yaml");
+  try {
+    gnss_config(bad_baud.section("gnss"));
+    FAIL() << "accepted baud 12345";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("gnss.yaml"), std::string::npos) << e.what();
+  }
+  const auto bad_format = ConfigSection::load_string("camera: { format: H264 }\n", "cam.yaml");
+  EXPECT_THROW(camera_config(bad_format.section("camera")), ConfigError);
+  const auto bad_profile = ConfigSection::load_string("imu: { profile: canopen }\n", "imu.yaml");
+  EXPECT_THROW(can_imu_config(bad_profile.section("imu")), ConfigError);
+}
+
+}  // namespace
+}  // namespace semap::drivers

@@ -1,0 +1,144 @@
+// DriverRunner's thread, reconnect and counting logic, exercised with a small driver that reads
+// 32-bit values from a real file (removing the file stands for the device vanishing).
+#include "semap/drivers/driver_runner.hpp"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <thread>
+
+#include "semap/drivers/driver_error.hpp"
+
+namespace semap::drivers {
+namespace {
+
+using namespace std::chrono_literals;
+
+class FileDriver : public DriverRunner {
+ public:
+  FileDriver(std::string path, common::SpscRing<std::uint32_t>& ring, BackoffConfig backoff)
+      : DriverRunner("file_driver", backoff), path_(std::move(path)), ring_(ring) {}
+  ~FileDriver() override { stop(); }
+
+ protected:
+  void open_device() override {
+    fd_ = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) throw_errno("open " + path_);
+  }
+  void service_device(std::stop_token) override {
+    std::uint32_t value = 0;
+    const ssize_t n = ::read(fd_, &value, sizeof(value));
+    if (n == sizeof(value)) {
+      counters().add_bytes(sizeof(value));
+      deliver(ring_, std::move(value));
+      return;
+    }
+    struct stat st {};
+    if (::fstat(fd_, &st) == 0 && st.st_nlink == 0) {
+      throw DriverError(path_ + ": removed", ENODEV);
+    }
+    std::this_thread::sleep_for(1ms);
+  }
+  void close_device() noexcept override {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+
+ private:
+  std::string path_;
+  common::SpscRing<std::uint32_t>& ring_;
+  int fd_ = -1;
+};
+
+bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return done();
+    std::this_thread::sleep_for(2ms);
+  }
+  return true;
+}
+
+class DriverRunnerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = std::filesystem::temp_directory_path() /
+            ("semap-driver-runner-" + std::to_string(::getpid()) + "-" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove(path_);
+  }
+  void TearDown() override { std::filesystem::remove(path_); }
+
+  void write_values(std::uint32_t first, std::uint32_t count) {
+    std::ofstream out(path_, std::ios::binary | std::ios::app);
+    for (std::uint32_t v = first; v < first + count; ++v) {
+      out.write(reinterpret_cast<const char*>(&v), sizeof(v));
+    }
+  }
+
+  std::filesystem::path path_;
+};
+
+TEST_F(DriverRunnerTest, NeverBlocksOnAFullRingAndCountsTheDrops) {
+  write_values(0, 100);
+  common::SpscRing<std::uint32_t> ring(8, common::OverflowPolicy::kDropOldest);
+  FileDriver driver(path_.string(), ring, {});
+  driver.start();
+  ASSERT_TRUE(wait_until([&] { return driver.stats().frames == 100; }, 5s));
+  driver.stop();
+  EXPECT_EQ(driver.stats().ring_drops, 92u);
+  EXPECT_EQ(driver.stats().bytes, 400u);
+  std::uint32_t v = 0;
+  ASSERT_TRUE(ring.try_pop(v));
+  EXPECT_EQ(v, 92u);  // drop-oldest kept the newest eight
+}
+
+TEST_F(DriverRunnerTest, RetriesAMissingDeviceWithoutCountingAReconnect) {
+  common::SpscRing<std::uint32_t> ring(64, common::OverflowPolicy::kDropOldest);
+  FileDriver driver(path_.string(), ring, {.initial = 5ms, .max = 20ms, .factor = 2.0});
+  driver.start();
+  ASSERT_TRUE(wait_until([&] { return driver.failures() >= 2; }, 5s));
+  EXPECT_EQ(driver.state(), DriverState::kConnecting);
+  EXPECT_NE(driver.last_error().find("No such file"), std::string::npos);
+  write_values(7, 1);
+  ASSERT_TRUE(wait_until([&] { return driver.stats().frames == 1; }, 5s));
+  EXPECT_EQ(driver.state(), DriverState::kRunning);
+  EXPECT_EQ(driver.stats().reconnects, 0u);
+}
+
+TEST_F(DriverRunnerTest, ReportsALostDeviceAndCountsTheReconnect) {
+  write_values(0, 3);
+  common::SpscRing<std::uint32_t> ring(64, common::OverflowPolicy::kDropOldest);
+  FileDriver driver(path_.string(), ring, {.initial = 5ms, .max = 20ms, .factor = 2.0});
+  driver.start();
+  ASSERT_TRUE(wait_until([&] { return driver.stats().frames == 3; }, 5s));
+  std::filesystem::remove(path_);
+  ASSERT_TRUE(wait_until([&] { return driver.failures() >= 1; }, 5s));
+  EXPECT_NE(driver.state(), DriverState::kRunning);
+  EXPECT_NE(driver.last_error().find("removed"), std::string::npos) << driver.last_error();
+  write_values(3, 2);
+  ASSERT_TRUE(wait_until([&] { return driver.stats().frames == 5; }, 5s));
+  EXPECT_EQ(driver.stats().reconnects, 1u);
+  driver.stop();
+  EXPECT_EQ(driver.state(), DriverState::kStopped);
+}
+
+TEST_F(DriverRunnerTest, StopIsPromptDuringALongBackoff) {
+  common::SpscRing<std::uint32_t> ring(8, common::OverflowPolicy::kDropOldest);
+  FileDriver driver(path_.string(), ring, {.initial = 10'000ms, .max = 10'000ms, .factor = 1.0});
+  driver.start();
+  ASSERT_TRUE(wait_until([&] { return driver.failures() == 1; }, 5s));
+  const auto t0 = std::chrono::steady_clock::now();
+  driver.stop();
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 1s);
+  EXPECT_EQ(driver.state(), DriverState::kStopped);
+}
+
+}  // namespace
+}  // namespace semap::drivers
