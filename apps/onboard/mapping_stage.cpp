@@ -3,7 +3,6 @@
 #include <tbb/task_arena.h>
 
 #include <chrono>
-#include <cmath>
 
 #include "semap/mapping/cell_posterior.hpp"
 
@@ -78,10 +77,10 @@ void MappingStage::run(std::stop_token stop) {
 
 void MappingStage::insert(const common::LabeledCloud& cloud) {
   const auto t0 = std::chrono::steady_clock::now();
-  map_.insert(cloud, cloud.origin);
+  const auto result = map_.insert(cloud, cloud.origin);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  auto snapshots = snapshots_near(cloud);
+  auto snapshots = snapshots_of(result.updated_blocks);
   local_.scans++;
   local_.points += cloud.size();
   local_.blocks_changed += snapshots.size();
@@ -93,29 +92,13 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   shared_ = local_;
 }
 
-// Every block inside the scan's bounding box grown by the kernel support: training points
-// (hits and free-space samples between origin and hits) all lie in it.
-std::vector<dds_idl::BlockSnapshot> MappingStage::snapshots_near(
-    const common::LabeledCloud& cloud) {
+std::vector<dds_idl::BlockSnapshot> MappingStage::snapshots_of(
+    const std::vector<mapping::BlockIndex>& updated) {
   std::vector<dds_idl::BlockSnapshot> out;
-  if (cloud.points.empty()) return out;
-  Eigen::Vector3f lo = cloud.origin;
-  Eigen::Vector3f hi = cloud.origin;
-  for (const auto& p : cloud.points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const float grow = config_.map.method == mapping::Method::kBki ? config_.map.ell : 0.0f;
-  const auto a = map_.block_of(lo.array() - grow);
-  const auto b = map_.block_of(hi.array() + grow);
-  for (int z = a.z; z <= b.z; ++z) {
-    for (int y = a.y; y <= b.y; ++y) {
-      for (int x = a.x; x <= b.x; ++x) {
-        const mapping::BlockIndex index{x, y, z};
-        if (const auto* block = map_.find_block(index)) {
-          out.push_back(to_snapshot(map_, index, *block, ++versions_[index]));
-        }
-      }
+  out.reserve(updated.size());
+  for (const auto& index : updated) {
+    if (const auto* block = map_.find_block(index)) {
+      out.push_back(to_snapshot(map_, index, *block, ++versions_[index]));
     }
   }
   return out;

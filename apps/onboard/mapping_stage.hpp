@@ -24,7 +24,7 @@ struct MappingStageStats {
 };
 
 // Owns the SemanticMap on its own thread: inserts every posed cloud and hands a snapshot of
-// each block the scan could have touched to the block sink (the DDS map publisher).
+// each block the insert wrote to the block sink (the DDS map publisher).
 class MappingStage {
  public:
   using BlockSink = std::function<void(std::vector<dds_idl::BlockSnapshot>&&, common::Stamp)>;
@@ -44,7 +44,7 @@ class MappingStage {
  private:
   void run(std::stop_token stop);
   void insert(const common::LabeledCloud& cloud);
-  std::vector<dds_idl::BlockSnapshot> snapshots_near(const common::LabeledCloud& cloud);
+  std::vector<dds_idl::BlockSnapshot> snapshots_of(const std::vector<mapping::BlockIndex>& updated);
 
   const OnboardConfig& config_;
   common::SpscRing<common::LabeledCloud>& clouds_;

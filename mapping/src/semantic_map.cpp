@@ -226,6 +226,7 @@ InsertResult SemanticMap::insert(const TrainingSet& training) {
         }
       });
   result.blocks_updated = groups.blocks.size();
+  result.updated_blocks = groups.blocks;
   ++scans_;
   return result;
 }

@@ -6,6 +6,7 @@
 #include <optional>
 #include <span>
 #include <unordered_map>
+#include <vector>
 
 #include "semap/common/messages.hpp"
 #include "semap/mapping/block.hpp"
@@ -34,6 +35,7 @@ struct InsertResult {
   std::size_t rejected_points = 0;
   std::size_t out_of_range = 0;
   std::size_t blocks_updated = 0;
+  std::vector<BlockIndex> updated_blocks;  // the blocks this insert wrote to
 };
 
 // The continuous semantic map of Gan et al. (S-CSM / S-BKI): a hash map of blocks of cells,
