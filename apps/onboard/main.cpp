@@ -185,7 +185,10 @@ int main(int argc, char** argv) {
   app.add_option("--config", config_path, "YAML configuration (see config/sim.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
+  std::optional<int> domain;
   app.add_option("--duration", duration, "seconds to run; overrides rig.duration_s (0: Ctrl-C)");
+  app.add_option("--domain", domain, "DDS domain id; overrides dds.domain")
+      ->check(CLI::Range(0, 232));
   CLI11_PARSE(app, argc, argv);
 
   semap::onboard::OnboardConfig config;
@@ -196,6 +199,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (duration) config.rig.duration_s = *duration;
+  if (domain) config.dds.domain = *domain;
   semap::common::setup_logging(config.log_level);
   if (config.dds.enabled && !config.dds.cyclone_config.empty() && !std::getenv("CYCLONEDDS_URI")) {
     setenv("CYCLONEDDS_URI", ("file://" + config.dds.cyclone_config.string()).c_str(), 1);

@@ -77,13 +77,10 @@ void read_camera(const ConfigSection& s, CameraConfig& cam) {
   s.finish();
 }
 
-void read_dds(const ConfigSection& s, const std::filesystem::path& yaml, DdsConfig& dds) {
+void read_dds(const ConfigSection& s, DdsConfig& dds) {
   dds.enabled = s.get<bool>("enabled", true);
   if (s.has("config")) {
-    dds.cyclone_config = s.get<std::string>("config");
-    if (dds.cyclone_config.is_relative()) {
-      dds.cyclone_config = std::filesystem::absolute(yaml).parent_path() / dds.cyclone_config;
-    }
+    dds.cyclone_config = std::filesystem::absolute(s.get<std::string>("config"));
   }
   dds.domain = static_cast<int>(s.get_in_range("domain", 0, 0, 232));
   dds.ns = s.get<std::string>("namespace", "");
@@ -121,7 +118,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   c.map_threads = static_cast<int>(map.get_in_range("threads", 2, 1, 64));
   map.finish();
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
-  read_dds(root.section_or_empty("dds"), path, c.dds);
+  read_dds(root.section_or_empty("dds"), c.dds);
   root.finish();
   c.map.validate();
   return c;

@@ -57,8 +57,8 @@ struct CameraConfig {
 
 struct DdsConfig {
   bool enabled = true;
-  // Cyclone XML (relative paths are relative to the YAML file); exported as CYCLONEDDS_URI
-  // unless the environment already sets it.
+  // Cyclone XML (relative to the working directory, like the other semap apps); exported as
+  // CYCLONEDDS_URI unless the environment already sets it.
   std::filesystem::path cyclone_config;
   int domain = 0;
   std::string ns;
