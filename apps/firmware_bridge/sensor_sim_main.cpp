@@ -154,7 +154,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"semap", "j1939"}));
   app.add_option("--base-id", base_id, "semap profile: first CAN id (4-aligned)")
       ->check(CLI::Range(0u, 0x7FCu));
-  auto* serial_opt = app.add_option("--serial", serial, "serial device (or pty slave) for GNSS");
+  auto* serial_opt = app.add_option(
+      "--serial", serial, "serial device for GNSS (a real UART, or one end of a socat pty pair)");
   app.add_flag("--pty", use_pty, "create a pty for GNSS and print its slave path")
       ->excludes(serial_opt);
   app.add_option("--baud", baud, "serial baud rate");
