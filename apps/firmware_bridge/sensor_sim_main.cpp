@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
   bool can_fd = false;
   std::string imu_profile = "semap";
   std::uint32_t base_id = SEMAP_CAN_IMU_DEFAULT_BASE_ID;
+  unsigned j1939_source = 0x80;
   std::string serial;
   bool use_pty = false;
   int baud = 115200;
@@ -154,7 +155,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"semap", "j1939"}));
   app.add_option("--base-id", base_id, "semap profile: first CAN id (4-aligned)")
       ->check(CLI::Range(0u, 0x7FCu));
-  auto* serial_opt = app.add_option("--serial", serial, "serial device (or pty slave) for GNSS");
+  app.add_option("--j1939-source", j1939_source, "j1939 profile: source address")
+      ->check(CLI::Range(0u, 253u));
+  auto* serial_opt = app.add_option(
+      "--serial", serial, "serial device for GNSS (a real UART, or one end of a socat pty pair)");
   app.add_flag("--pty", use_pty, "create a pty for GNSS and print its slave path")
       ->excludes(serial_opt);
   app.add_option("--baud", baud, "serial baud rate");
@@ -204,6 +208,7 @@ int main(int argc, char** argv) {
     config.imu_profile = imu_profile == "j1939" ? fb::ImuProfile::kJ1939 : fb::ImuProfile::kSemap;
     config.can_fd_frames = can_fd;
     config.base_id = base_id;
+    config.j1939_source = static_cast<std::uint8_t>(j1939_source);
     config.gnss_protocol = protocol == "ubx" ? fb::GnssProtocol::kUbx : fb::GnssProtocol::kNmea;
     config.speed = speed;
     config.faults = faults;

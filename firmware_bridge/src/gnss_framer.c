@@ -73,7 +73,9 @@ SemapFbResult semap_gnss_framer_next(SemapGnssFramer* f, SemapGnssFrame* out) {
           f->counters.nmea_frames++;
           return result(SEMAP_FB_OK);
         }
-        if (c == '$' || (c != '\r' && (c < 0x20u || c > 0x7Eu))) {
+        /* CR belongs to a sentence only as the first half of its CR LF ending. */
+        const int stray_cr = c == '\r' && k + 1 < n && b[k + 1] != '\n';
+        if (c == '$' || stray_cr || (c != '\r' && (c < 0x20u || c > 0x7Eu))) {
           skip(f, k, 0);
           f->counters.truncated++;
           return result(SEMAP_FB_TRUNCATED);

@@ -71,6 +71,8 @@ static int parse_coordinate(Field value, Field hemi, double max_deg, char positi
   if (value.n == 0 || hemi.n != 1 || !semap_nmea_parse_decimal(value.s, value.n, &v) || v < 0.0) {
     return 0;
   }
+  /* Bound before the integer cast: long may be 32 bits on an MCU. */
+  if (v >= 100.0 * (max_deg + 1.0)) return 0;
   const double whole = (double)(long)(v / 100.0);
   const double minutes = v - whole * 100.0;
   if (minutes >= 60.0) return 0;

@@ -81,8 +81,12 @@ static void put_time(Writer* w, uint8_t has, int32_t ms) {
 /* (d)ddmm.mmmmmm: 1e-6 minute is about 2 mm, well inside RTK precision. */
 static void put_coordinate(Writer* w, uint8_t has, double deg, int deg_digits, char positive,
                            char negative) {
+  const double a = deg < 0.0 ? -deg : deg;
+  if (has && !(a <= 180.0)) { /* also NaN: never cast it to an integer */
+    w->overflow = 1;
+    return;
+  }
   if (has) {
-    const double a = deg < 0.0 ? -deg : deg;
     const uint64_t micro_min = (uint64_t)(a * 60e6 + 0.5);
     put_uint(w, micro_min / 60000000u, deg_digits);
     put_uint(w, micro_min % 60000000u / 1000000u, 2);

@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <numbers>
-#include <regex>
 #include <string>
 
 #include "semap/firmware_bridge/can_imu.h"
@@ -32,25 +32,25 @@ struct Message {
 std::map<std::string, Message> load_dbc() {
   std::ifstream in(SEMAP_SOURCE_DIR "/firmware_bridge/imu.dbc");
   EXPECT_TRUE(in) << "imu.dbc missing";
-  const std::regex bo(R"(^BO_ (\d+) (\w+): (\d+) \w+)");
-  const std::regex sg(R"(^ SG_ (\w+) : (\d+)\|(\d+)@1([+-]) \(([-0-9.e]+),([-0-9.e]+)\))");
   std::map<std::string, Message> messages;
   Message* current = nullptr;
   std::string line;
-  std::smatch m;
   while (std::getline(in, line)) {
-    if (std::regex_search(line, m, bo)) {
-      current = &messages[m[2]];
-      current->id = static_cast<std::uint32_t>(std::stoul(m[1]));
-      current->dlc = std::stoi(m[3]);
-    } else if (current && std::regex_search(line, m, sg)) {
-      Signal s;
-      s.start = std::stoi(m[2]);
-      s.length = std::stoi(m[3]);
-      s.is_signed = m[4] == "-";
-      s.scale = std::stod(m[5]);
-      s.offset = std::stod(m[6]);
-      current->signals[m[1]] = s;
+    char name[64];
+    unsigned long id = 0;
+    int dlc = 0;
+    int start = 0;
+    int length = 0;
+    char sign = 0;
+    double scale = 0.0;
+    double offset = 0.0;
+    if (std::sscanf(line.c_str(), "BO_ %lu %63[^:]: %d", &id, name, &dlc) == 3) {
+      current = &messages[name];
+      current->id = static_cast<std::uint32_t>(id);
+      current->dlc = dlc;
+    } else if (current && std::sscanf(line.c_str(), " SG_ %63s : %d|%d@1%c (%lf,%lf)", name, &start,
+                                      &length, &sign, &scale, &offset) == 6) {
+      current->signals[name] = Signal{start, length, sign == '-', scale, offset};
     } else if (line.rfind(" SG_", 0) == 0) {
       ADD_FAILURE() << "unparsed signal line (only little-endian signals expected): " << line;
     }

@@ -123,6 +123,18 @@ TEST(GnssFramer, CountsTruncatedSentencesAndFramesOnce) {
   EXPECT_EQ(e.bad_checksum, 1) << "the cut UBX frame swallows the next one's start once";
 }
 
+TEST(GnssFramer, AStrayCarriageReturnEndsASentence) {
+  std::vector<std::uint8_t> stream = bytes(kGga.substr(0, 20));
+  append(stream, {'\r', 0x01});
+  append(stream, bytes(kVtg));
+  SemapGnssFramer f;
+  const Events e = run(stream, 1, f);
+  EXPECT_EQ(e.truncated, 1);
+  EXPECT_EQ(f.counters.garbage_bytes, 2u);
+  ASSERT_EQ(e.nmea.size(), 1u);
+  EXPECT_EQ(e.nmea[0], kVtg);
+}
+
 TEST(GnssFramer, RejectsOverlongLinesAndLengths) {
   std::string longline = "$GPGGA," + std::string(100, '1') + "\r\n";
   std::vector<std::uint8_t> stream = bytes(longline);

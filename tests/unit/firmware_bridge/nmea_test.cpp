@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -168,8 +169,11 @@ TEST(Nmea, EncodersRoundTripThroughTheParser) {
   EXPECT_EQ(s.u.gga.quality, 4);
   EXPECT_EQ(s.u.gga.satellites, 17);
   EXPECT_DOUBLE_EQ(s.u.gga.altitude_msl_m, -12.345);
-  // Too small a buffer fails cleanly instead of writing past it.
+  // Too small a buffer or an impossible coordinate fails cleanly.
   EXPECT_EQ(semap_nmea_encode_gga(&gga, SEMAP_NMEA_TALKER_GN, buf, 20), 0u);
+  SemapNmeaGga nan_position = gga;
+  nan_position.latitude_deg = std::nan("");
+  EXPECT_EQ(semap_nmea_encode_gga(&nan_position, SEMAP_NMEA_TALKER_GN, buf, sizeof buf), 0u);
 
   SemapNmeaRmc rmc{};
   rmc.has_time = rmc.has_position = rmc.has_speed = rmc.has_course = rmc.has_date = 1;

@@ -15,7 +15,7 @@ enum class ImuProfile : std::uint8_t { kSemap, kJ1939 };
 
 struct CanImuDecoderConfig {
   ImuProfile profile = ImuProfile::kSemap;
-  std::uint32_t base_id = SEMAP_CAN_IMU_DEFAULT_BASE_ID;  // semap profile
+  std::uint32_t base_id = SEMAP_CAN_IMU_DEFAULT_BASE_ID;  // semap profile, 4-aligned
   std::uint16_t j1939_source = SEMAP_J1939_ADDRESS_ANY;   // j1939 profile
 };
 

@@ -3,7 +3,6 @@
 #include <atomic>
 #include <cstdint>
 #include <random>
-#include <string>
 
 #include "semap/firmware_bridge/can_imu_decoder.hpp"
 #include "semap/firmware_bridge/nmea.h"
