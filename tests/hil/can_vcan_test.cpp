@@ -298,12 +298,13 @@ TEST_F(VcanTest, ResumesAfterInterfaceDownAndUp) {
   const auto& got = received_.samples;
   std::printf(
       "vcan down/up: sent %llu samples (%llu frame writes failed while down), received "
-      "%zu, missed %llu, failures %llu, reconnects %llu, last error '%s'\n",
+      "%zu, missed %llu, failures %llu, reconnects %llu, lost: '%s'\n",
       (unsigned long long)sent.imu_samples, (unsigned long long)sent.can_write_failures, got.size(),
       (unsigned long long)c.missed_samples, (unsigned long long)driver.failures(),
-      (unsigned long long)driver.stats().reconnects, driver.last_error().c_str());
+      (unsigned long long)driver.stats().reconnects, driver.last_loss().c_str());
   EXPECT_TRUE(reported);
   EXPECT_NE(while_down, DriverState::kRunning);
+  EXPECT_NE(driver.last_loss().find("Network is down"), std::string::npos) << driver.last_loss();
   EXPECT_NE(driver.last_error().find("down"), std::string::npos) << driver.last_error();
   EXPECT_GT(sent.can_write_failures, 0u);
   // It resumed: samples after the outage arrived, up to the emulator's last one.
