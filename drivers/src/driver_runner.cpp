@@ -57,16 +57,23 @@ std::string DriverRunner::last_error() const {
   return last_error_;
 }
 
-void DriverRunner::report(const std::string& message) {
+std::string DriverRunner::last_loss() const {
+  std::lock_guard lock(error_mutex_);
+  return last_loss_;
+}
+
+void DriverRunner::report(const std::string& message, bool lost) {
   log_->warn("{}", message);
   std::lock_guard lock(error_mutex_);
   last_error_ = message;
+  if (lost) last_loss_ = message;
 }
 
 void DriverRunner::run(std::stop_token stop) {
   Backoff backoff(backoff_config_);
   bool ever_connected = false;
   while (!stop.stop_requested()) {
+    bool running = false;
     try {
       open_device();
       if (ever_connected) {
@@ -76,14 +83,16 @@ void DriverRunner::run(std::stop_token stop) {
       ever_connected = true;
       backoff.reset();
       state_.store(DriverState::kRunning, std::memory_order_release);
+      running = true;
       while (!stop.stop_requested()) service_device(stop);
       close_device();
       break;
     } catch (const std::exception& e) {
       // Any failure of the device, including ones thrown by decoders, ends this connection;
       // the thread survives and retries, so one bad device never takes the pipeline down.
+      // Reported before failures() moves, so a reader that sees the count sees the message.
+      report(e.what(), running);
       failures_.store(failures_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
-      report(e.what());
       close_device();
       state_.store(ever_connected ? DriverState::kReconnecting : DriverState::kConnecting,
                    std::memory_order_release);

@@ -166,8 +166,9 @@ TEST_F(VividTest, SurvivesUnbindAndResumesAfterRebind) {
 
   std::ofstream(sysfs + "unbind") << "vivid.0" << std::flush;
   ASSERT_TRUE(hil::wait_until([&] { return driver.failures() > 0; }, 10s));
-  std::printf("after unbind: state %s, error '%s'\n", to_string(driver.state()),
-              driver.last_error().c_str());
+  std::printf("after unbind: state %s, lost: '%s', then: '%s'\n", to_string(driver.state()),
+              driver.last_loss().c_str(), driver.last_error().c_str());
+  EXPECT_FALSE(driver.last_loss().empty());
   EXPECT_NE(driver.state(), DriverState::kRunning);
   std::this_thread::sleep_for(300ms);  // a few failed reopen attempts
   EXPECT_EQ(driver.stats().reconnects, 0u);

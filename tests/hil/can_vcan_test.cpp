@@ -118,7 +118,9 @@ TEST_F(VcanTest, Receives400HzFor10sWithoutLossCrcErrorsOrGaps) {
   firmware_bridge::CanSocket tx(kInterface, false);
   firmware_bridge::Emulator emulator(emulator_config(tx.fd(), 1.0));
   firmware_bridge::ConstantTurnSource source(truth(10.0));
+  const common::Stamp run_start = common::Stamp::now();
   emulator.run(source);
+  const common::Stamp run_end = common::Stamp::now();
   const auto sent = emulator.stats();
   EXPECT_TRUE(hil::wait_until([&] { return driver.stats().frames >= sent.imu_samples; }, 5s));
   driver.stop();
@@ -147,11 +149,17 @@ TEST_F(VcanTest, Receives400HzFor10sWithoutLossCrcErrorsOrGaps) {
     ASSERT_EQ(got[i].sequence, got[i - 1].sequence + 1) << i;
     ASSERT_GT(got[i].stamp, got[i - 1].stamp) << i;
   }
-  // Kernel receive stamps are on CLOCK_MONOTONIC: 10 s of samples span about 10 s of it.
+  // Kernel receive stamps, mapped onto CLOCK_MONOTONIC, fall inside the window in which the
+  // emulator wrote (vcan stamps a frame within the sender's write call). The slack covers the
+  // realtime/monotonic offset's uncertainty. The window is the emulator's real duration: in a
+  // starved VM it can exceed the 10 s of sensor time.
+  const double slack_s = 0.002;
+  EXPECT_GE(common::seconds_between(got.front().stamp, run_start), -slack_s);
+  EXPECT_LE(common::seconds_between(got.back().stamp, run_end), slack_s);
   const double span = common::seconds_between(got.back().stamp, got.front().stamp);
-  EXPECT_NEAR(span, 9.9975, 0.5);
-  EXPECT_LT(common::seconds_between(common::Stamp::now(), got.back().stamp), 10.0);
-  EXPECT_GE(common::seconds_between(common::Stamp::now(), got.back().stamp), 0.0);
+  EXPECT_GT(span, 9.9);
+  std::printf("vcan clean: stamps span %.3f s, emulator wrote for %.3f s\n", span,
+              common::seconds_between(run_end, run_start));
 }
 
 TEST_F(VcanTest, CountsInjectedCrcErrorsDropsAndGapsExactly) {
@@ -212,6 +220,53 @@ TEST_F(VcanTest, CountsInjectedCrcErrorsDropsAndGapsExactly) {
             received_.samples.size() + c.missed_samples);
 }
 
+// The CAN FD variant (one 64-byte frame per sample) and the J1939 profile (29-bit ids): 2 s of
+// 400 Hz sent at double speed, every sample through the kernel filter and the assembler.
+TEST_F(VcanTest, CanFdAndJ1939ProfilesArriveComplete) {
+  struct Case {
+    const char* name;
+    firmware_bridge::ImuProfile profile;
+    bool fd;
+  };
+  for (const Case& k : {Case{"semap CAN FD", firmware_bridge::ImuProfile::kSemap, true},
+                        Case{"J1939", firmware_bridge::ImuProfile::kJ1939, false}}) {
+    SCOPED_TRACE(k.name);
+    SpscRing<ImuSample> ring(4096, common::OverflowPolicy::kDropOldest);
+    auto c = config();
+    c.decoder.profile = k.profile;
+    c.fd_frames = k.fd;
+    CanImuDriver driver(c, ring);
+    driver.start();
+    ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
+
+    firmware_bridge::CanSocket tx(kInterface, k.fd);
+    auto ec = emulator_config(tx.fd(), 2.0);
+    ec.imu_profile = k.profile;
+    ec.can_fd_frames = k.fd;
+    firmware_bridge::Emulator emulator(ec);
+    firmware_bridge::ConstantTurnSource source(truth(2.0));
+    emulator.run(source);
+    const auto sent = emulator.stats();
+    EXPECT_TRUE(hil::wait_until([&] { return driver.stats().frames >= sent.imu_samples; }, 5s));
+    driver.stop();
+    const auto counters = driver.imu_counters();
+    std::printf("vcan %s: sent %llu samples in %llu frames, received %llu, errors %llu\n", k.name,
+                (unsigned long long)sent.imu_samples, (unsigned long long)sent.can_frames,
+                (unsigned long long)driver.stats().frames,
+                (unsigned long long)(counters.crc_errors + counters.bad_frames +
+                                     counters.incomplete + counters.unpaired));
+    EXPECT_EQ(sent.imu_samples, 800u);
+    EXPECT_EQ(sent.can_write_failures, 0u);
+    EXPECT_EQ(driver.stats().frames, sent.imu_samples);
+    EXPECT_EQ(counters.unknown, 0u);  // the kernel filter let only the profile's frames through
+    EXPECT_EQ(counters.crc_errors + counters.bad_frames + counters.incomplete + counters.unpaired,
+              0u);
+    ImuSample first;
+    ASSERT_TRUE(ring.try_pop(first));
+    EXPECT_NEAR(first.accel.norm(), 9.81, 0.1);  // gravity plus the small centripetal term
+  }
+}
+
 TEST_F(VcanTest, ResumesAfterInterfaceDownAndUp) {
   SpscRing<ImuSample> ring(4096, common::OverflowPolicy::kDropOldest);
   CanImuDriver driver(config(), ring);
@@ -243,12 +298,13 @@ TEST_F(VcanTest, ResumesAfterInterfaceDownAndUp) {
   const auto& got = received_.samples;
   std::printf(
       "vcan down/up: sent %llu samples (%llu frame writes failed while down), received "
-      "%zu, missed %llu, failures %llu, reconnects %llu, last error '%s'\n",
+      "%zu, missed %llu, failures %llu, reconnects %llu, lost: '%s'\n",
       (unsigned long long)sent.imu_samples, (unsigned long long)sent.can_write_failures, got.size(),
       (unsigned long long)c.missed_samples, (unsigned long long)driver.failures(),
-      (unsigned long long)driver.stats().reconnects, driver.last_error().c_str());
+      (unsigned long long)driver.stats().reconnects, driver.last_loss().c_str());
   EXPECT_TRUE(reported);
   EXPECT_NE(while_down, DriverState::kRunning);
+  EXPECT_NE(driver.last_loss().find("Network is down"), std::string::npos) << driver.last_loss();
   EXPECT_NE(driver.last_error().find("down"), std::string::npos) << driver.last_error();
   EXPECT_GT(sent.can_write_failures, 0u);
   // It resumed: samples after the outage arrived, up to the emulator's last one.

@@ -276,7 +276,7 @@ TEST_F(GnssPtyTest, HangUpIsReportedAndTheDriverReopens) {
 
   first->close();  // the adapter vanishes: the slave sees a hang-up
   ASSERT_TRUE(hil::wait_until([&] { return driver.failures() > 0; }, 5s));
-  EXPECT_NE(driver.last_error().find("hang-up"), std::string::npos) << driver.last_error();
+  EXPECT_NE(driver.last_loss().find("hang-up"), std::string::npos) << driver.last_loss();
   std::filesystem::remove(link_);
   std::this_thread::sleep_for(100ms);  // reopen attempts fail while the device is missing
   EXPECT_NE(driver.state(), DriverState::kRunning);

@@ -106,6 +106,7 @@ TEST_F(DriverRunnerTest, RetriesAMissingDeviceWithoutCountingAReconnect) {
   ASSERT_TRUE(wait_until([&] { return driver.failures() >= 2; }, 5s));
   EXPECT_EQ(driver.state(), DriverState::kConnecting);
   EXPECT_NE(driver.last_error().find("No such file"), std::string::npos);
+  EXPECT_TRUE(driver.last_loss().empty());  // never connected, so nothing was lost
   write_values(7, 1);
   ASSERT_TRUE(wait_until([&] { return driver.stats().frames == 1; }, 5s));
   EXPECT_EQ(driver.state(), DriverState::kRunning);
@@ -121,7 +122,7 @@ TEST_F(DriverRunnerTest, ReportsALostDeviceAndCountsTheReconnect) {
   std::filesystem::remove(path_);
   ASSERT_TRUE(wait_until([&] { return driver.failures() >= 1; }, 5s));
   EXPECT_NE(driver.state(), DriverState::kRunning);
-  EXPECT_NE(driver.last_error().find("removed"), std::string::npos) << driver.last_error();
+  EXPECT_NE(driver.last_loss().find("removed"), std::string::npos) << driver.last_loss();
   write_values(3, 2);
   ASSERT_TRUE(wait_until([&] { return driver.stats().frames == 5; }, 5s));
   EXPECT_EQ(driver.stats().reconnects, 1u);

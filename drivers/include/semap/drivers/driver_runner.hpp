@@ -42,6 +42,9 @@ class DriverRunner {
   DriverState state() const { return state_.load(std::memory_order_acquire); }
   DriverStats stats() const { return counters_.snapshot(); }
   std::string last_error() const;
+  // Why the last running connection ended (device lost), which later failed reopen attempts do
+  // not overwrite; empty while the device has never been lost.
+  std::string last_loss() const;
   const std::string& name() const { return name_; }
   // Number of failures reported (open failures and lost devices), for health reporting.
   std::uint64_t failures() const { return failures_.load(std::memory_order_acquire); }
@@ -61,7 +64,8 @@ class DriverRunner {
     counters_.add_frame();
   }
 
-  void report(const std::string& message);  // logs a warning and keeps it as last_error()
+  // Logs a warning and keeps it as last_error() (and as last_loss() when `lost`).
+  void report(const std::string& message, bool lost);
   DriverCounters& counters() { return counters_; }
   spdlog::logger& log() { return *log_; }
 
@@ -76,6 +80,7 @@ class DriverRunner {
   std::atomic<std::uint64_t> failures_{0};
   mutable std::mutex error_mutex_;
   std::string last_error_;
+  std::string last_loss_;
   std::jthread thread_;
 };
 
