@@ -267,22 +267,30 @@ int SemanticMap::label_at(const Eigen::Vector3f& point) const {
 }
 
 const Block* SemanticMap::find_block(const BlockIndex& index) const {
-  const auto it = blocks_.find(index);
-  return it == blocks_.end() ? nullptr : &it->second;
+  if (!VoxelHashMap::in_range(index)) return nullptr;
+  const std::uint32_t id = table_.find(index);
+  return id == VoxelHashMap::kNone ? nullptr : &blocks_[id];
 }
 
 Block& SemanticMap::block_at(const BlockIndex& index) {
-  auto it = blocks_.find(index);
-  if (it == blocks_.end()) {
-    it = blocks_
-             .emplace(std::piecewise_construct, std::forward_as_tuple(index),
-                      std::forward_as_tuple(params_.cells_per_side(), params_.num_classes))
-             .first;
+  const std::uint32_t id = table_.insert(index);
+  if (id == blocks_.size()) {
+    indices_.push_back(index);
+    blocks_.emplace_back(params_.cells_per_side(), params_.num_classes);
   }
-  return it->second;
+  return blocks_[id];
 }
 
 void SemanticMap::add_evidence(const BlockIndex& index, std::span<const float> evidence) {
+  if (!VoxelHashMap::in_range(index)) {
+    throw std::invalid_argument("block index beyond the map's +-2^20 range");
+  }
+  const std::size_t expected =
+      static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
+  if (evidence.size() != expected) {
+    throw std::invalid_argument("block evidence has " + std::to_string(evidence.size()) +
+                                " floats, expected " + std::to_string(expected));
+  }
   block_at(index).add_evidence(evidence);
 }
 
@@ -291,15 +299,13 @@ MapStats SemanticMap::stats() const {
   s.blocks = blocks_.size();
   s.scans = scans_;
   s.rejected_points = rejected_;
-  // Hash node: next pointer, key, block object, cached hash; plus the bucket array.
-  constexpr std::size_t kNodeBytes =
-      sizeof(void*) + sizeof(std::pair<const BlockIndex, Block>) + sizeof(std::size_t);
-  s.bytes = blocks_.bucket_count() * sizeof(void*);
-  for (const auto& [index, block] : blocks_) {
+  // Table, index list and the deque's slots, then every block with its two heap arrays.
+  s.bytes =
+      table_.bytes() + indices_.capacity() * sizeof(BlockIndex) + blocks_.size() * sizeof(Block);
+  for (const Block& block : blocks_) {
     s.cells += static_cast<std::size_t>(block.num_cells());
     s.observed_cells += static_cast<std::size_t>(block.num_observed());
-    // The node and the block's two arrays are three heap allocations.
-    s.bytes += kNodeBytes + block.bytes() - sizeof(Block) + 3 * kAllocOverhead;
+    s.bytes += block.bytes() - sizeof(Block) + 2 * kAllocOverhead;
   }
   return s;
 }
