@@ -40,7 +40,7 @@ bool mappable(const Eigen::Vector3f& p, float inv_res) {
 }
 
 // Cells a training point touches: for S-BKI all cells whose centre lies within ell per
-// axis (the sphere test follows per cell), for S-CSM the cell containing the point.
+// axis (rows are trimmed to the sphere later), for S-CSM the cell containing the point.
 CellBox support_of(const Eigen::Vector3f& p, const MapParams& params) {
   const float inv_res = 1.0f / params.resolution;
   CellBox box{};
@@ -252,10 +252,12 @@ InsertResult SemanticMap::insert(const TrainingSet& training) {
 }
 
 BlockIndex SemanticMap::block_of(const Eigen::Vector3f& point) const {
-  const float inv = 1.0f / params_.block_size();
-  return {static_cast<std::int32_t>(std::floor(point.x() * inv)),
-          static_cast<std::int32_t>(std::floor(point.y() * inv)),
-          static_cast<std::int32_t>(std::floor(point.z() * inv))};
+  // Through the cell index, exactly as insert() and query() do, so boundaries agree.
+  const float inv_res = 1.0f / params_.resolution;
+  const std::int32_t n = params_.cells_per_side();
+  return {floor_div(fast_floor(point.x() * inv_res), n),
+          floor_div(fast_floor(point.y() * inv_res), n),
+          floor_div(fast_floor(point.z() * inv_res), n)};
 }
 
 Eigen::Vector3f SemanticMap::cell_center(const BlockIndex& block, int cell) const {
