@@ -150,16 +150,24 @@ void Estimator::try_initialise() {
   mean_gyro /= n;
   mean_accel /= n;
   double accel_var = 0.0;
-  for (const auto& s : init_window_) accel_var += (s.accel - mean_accel).squaredNorm();
+  double gyro_var = 0.0;
+  for (const auto& s : init_window_) {
+    accel_var += (s.accel - mean_accel).squaredNorm();
+    gyro_var += (s.gyro - mean_gyro).squaredNorm() / 3.0;
+  }
   accel_var /= n;
+  gyro_var /= n;
+  const double gyro_bias_sigma =
+      std::max(config_.init.min_gyro_bias_sigma_rad_s, 3.0 * std::sqrt(gyro_var / n));
   const auto& ic = config_.init;
   if (mean_gyro.norm() > ic.static_gyro_max_rad_s ||
       std::sqrt(accel_var) > ic.static_accel_std_max_m_s2) {
     ++counters_.init_not_static;
     common::logger("estimation")
-        ->warn("initialising from a window that is not static (|gyro| {:.3f} rad/s, accel std "
-               "{:.3f} m/s^2)",
-               mean_gyro.norm(), std::sqrt(accel_var));
+        ->warn(
+            "initialising from a window that is not static (|gyro| {:.3f} rad/s, accel std "
+            "{:.3f} m/s^2)",
+            mean_gyro.norm(), std::sqrt(accel_var));
   }
 
   // At rest the accelerometer measures R^T (0, 0, g): roll and pitch follow from its direction.
@@ -174,11 +182,9 @@ void Estimator::try_initialise() {
   Matrix15 p = Matrix15::Zero();
   p.block<3, 3>(kRot, kRot).diagonal() << ic.tilt_sigma_rad * ic.tilt_sigma_rad,
       ic.tilt_sigma_rad * ic.tilt_sigma_rad, ic.yaw_sigma_rad * ic.yaw_sigma_rad;
-  p.block<3, 3>(kVel, kVel) =
-      Matrix3d::Identity() * ic.velocity_sigma_m_s * ic.velocity_sigma_m_s;
+  p.block<3, 3>(kVel, kVel) = Matrix3d::Identity() * ic.velocity_sigma_m_s * ic.velocity_sigma_m_s;
   p.block<3, 3>(kPos, kPos) = init_fix_->covariance;
-  p.block<3, 3>(kGyroBias, kGyroBias) =
-      Matrix3d::Identity() * ic.gyro_bias_sigma_rad_s * ic.gyro_bias_sigma_rad_s;
+  p.block<3, 3>(kGyroBias, kGyroBias) = Matrix3d::Identity() * gyro_bias_sigma * gyro_bias_sigma;
   p.block<3, 3>(kAccelBias, kAccelBias) =
       Matrix3d::Identity() * ic.accel_bias_sigma_m_s2 * ic.accel_bias_sigma_m_s2;
   filter_->reset(x, p);
@@ -189,8 +195,8 @@ void Estimator::try_initialise() {
   record_pose();
   common::logger("estimation")
       ->info("initialised at {:.3f} s: roll {:.2f} deg, pitch {:.2f} deg, yaw guess {:.1f} deg",
-             filter_time_.seconds(), roll * 180.0 / std::numbers::pi, pitch * 180.0 / std::numbers::pi,
-             ic.yaw_rad * 180.0 / std::numbers::pi);
+             filter_time_.seconds(), roll * 180.0 / std::numbers::pi,
+             pitch * 180.0 / std::numbers::pi, ic.yaw_rad * 180.0 / std::numbers::pi);
 }
 
 void Estimator::apply_gnss(const common::GnssFix& fix) {
@@ -225,8 +231,10 @@ void Estimator::note_rejection(const Vector3d& residual) {
   mean /= static_cast<double>(rejected_run_.size());
   double spread = 0.0;
   for (const auto& r : rejected_run_) spread = std::max(spread, (r - mean).norm());
-  if (spread > config_.reanchor.max_spread_m) {
-    // Scattered outliers or a diverging filter, not a jump: keep gating.
+  const double yaw_var = filter_->rotation_covariance_world()(2, 2);
+  if (spread > config_.reanchor.max_spread_m ||
+      !(yaw_var < config_.reanchor.max_yaw_sigma_rad * config_.reanchor.max_yaw_sigma_rad)) {
+    // Scattered outliers or an unconverged or diverging filter, not a jump: keep gating.
     rejected_run_.erase(rejected_run_.begin());
     return;
   }
@@ -235,10 +243,11 @@ void Estimator::note_rejection(const Vector3d& residual) {
   ++counters_.reanchors;
   rejected_run_.clear();
   common::logger("estimation")
-      ->warn("GNSS jump of {:.2f} m persisted for {} fixes: re-anchored (offset now {:.2f}, "
-             "{:.2f}, {:.2f})",
-             mean.norm(), config_.reanchor.after_rejections, anchor_offset_.x(),
-             anchor_offset_.y(), anchor_offset_.z());
+      ->warn(
+          "GNSS jump of {:.2f} m persisted for {} fixes: re-anchored (offset now {:.2f}, "
+          "{:.2f}, {:.2f})",
+          mean.norm(), config_.reanchor.after_rejections, anchor_offset_.x(), anchor_offset_.y(),
+          anchor_offset_.z());
 }
 
 void Estimator::record_pose() {

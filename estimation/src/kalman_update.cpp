@@ -7,8 +7,8 @@ namespace semap::estimation {
 KalmanUpdate joseph_update(Matrix15& covariance, const Eigen::Vector3d& innovation,
                            const Matrix3x15& h, const Eigen::Matrix3d& noise, double gate2) {
   KalmanUpdate out;
-  const Eigen::Matrix<double, 15, 3> pht = covariance * h.transpose();
-  const Eigen::Matrix3d s = h * pht + noise;
+  const Eigen::Matrix<double, 15, 3> pht = covariance.lazyProduct(h.transpose());
+  const Eigen::Matrix3d s = h.lazyProduct(pht) + noise;
   const Eigen::LLT<Eigen::Matrix3d> llt(s);
   if (llt.info() != Eigen::Success) return out;
   out.mahalanobis2 = innovation.dot(llt.solve(innovation));
@@ -18,11 +18,11 @@ KalmanUpdate joseph_update(Matrix15& covariance, const Eigen::Vector3d& innovati
   const Eigen::Matrix<double, 15, 3> k = llt.solve(pht.transpose()).transpose();
   out.delta.noalias() = k * innovation;
   Matrix15 ap = covariance;
-  ap.noalias() -= k * pht.transpose();  // (I - K H) P, using H P = (P H^T)^T
+  ap -= k.lazyProduct(pht.transpose());  // (I - K H) P, using H P = (P H^T)^T
   Eigen::Matrix<double, 15, 3> m = k * noise;
-  m.noalias() -= ap * h.transpose();    // K N - A P H^T
+  m -= ap.lazyProduct(h.transpose());  // K N - A P H^T
   covariance = ap;
-  covariance.noalias() += m * k.transpose();  // A P A^T + K N K^T
+  covariance += m.lazyProduct(k.transpose());  // A P A^T + K N K^T
   covariance = 0.5 * (covariance + covariance.transpose()).eval();
   return out;
 }

@@ -10,9 +10,7 @@ namespace {
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
-Eigen::Quaterniond quaternion_exp(const Vector3d& phi) {
-  return Eigen::Quaterniond(gamma0(phi));
-}
+Eigen::Quaterniond quaternion_exp(const Vector3d& phi) { return Eigen::Quaterniond(gamma0(phi)); }
 }  // namespace
 
 QuaternionEskf::QuaternionEskf(const FilterParams& params)

@@ -21,7 +21,7 @@ struct EstimatorCounters {
   ImuCounters imu;
   GnssBufferCounters gnss_buffer;
   std::uint64_t gnss_received = 0;
-  std::uint64_t gnss_invalid = 0;   // no fix, non-finite values or a bad covariance
+  std::uint64_t gnss_invalid = 0;  // no fix, non-finite values or a bad covariance
   std::uint64_t gnss_applied = 0;
   std::uint64_t gnss_rejected = 0;  // failed the chi-square gate
   std::uint64_t velocity_applied = 0;

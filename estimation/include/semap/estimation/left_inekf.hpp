@@ -16,8 +16,7 @@ struct LeftInekfTransition {
   double dt = 0.0;
 
   // The transition for bias-corrected rates w and accelerations a held over dt.
-  static LeftInekfTransition compute(const Eigen::Vector3d& w, const Eigen::Vector3d& a,
-                                     double dt);
+  static LeftInekfTransition compute(const Eigen::Vector3d& w, const Eigen::Vector3d& a, double dt);
   Matrix15 dense() const;
 };
 
