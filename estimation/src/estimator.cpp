@@ -207,6 +207,7 @@ void Estimator::apply_gnss(const common::GnssFix& fix) {
   if (r.accepted) {
     ++counters_.gnss_applied;
     rejected_run_.clear();
+    consecutive_rejections_ = 0;
   } else {
     ++counters_.gnss_rejected;
     common::logger("estimation")
@@ -225,23 +226,47 @@ void Estimator::apply_gnss(const common::GnssFix& fix) {
 
 void Estimator::note_rejection(const Vector3d& residual) {
   rejected_run_.push_back(residual);
+  if (++consecutive_rejections_ >= config_.reanchor.diverged_after_rejections) {
+    const double var = residual.squaredNorm();
+    const double window_s = 0.1 * consecutive_rejections_;
+    filter_->inflate(Matrix3d::Identity() * var,
+                     Matrix3d::Identity() * var / (window_s * window_s));
+    ++counters_.position_inflations;
+    common::logger("estimation")
+        ->warn(
+            "{} GNSS fixes in a row gated out (residual {:.1f} m): filter diverged, position "
+            "and velocity uncertainty inflated",
+            consecutive_rejections_, residual.norm());
+    consecutive_rejections_ = 0;
+    rejected_run_.clear();
+    return;
+  }
   if (static_cast<int>(rejected_run_.size()) < config_.reanchor.after_rejections) return;
   Vector3d mean = Vector3d::Zero();
   for (const auto& r : rejected_run_) mean += r;
   mean /= static_cast<double>(rejected_run_.size());
   double spread = 0.0;
   for (const auto& r : rejected_run_) spread = std::max(spread, (r - mean).norm());
-  const double yaw_var = filter_->rotation_covariance_world()(2, 2);
-  if (spread > config_.reanchor.max_spread_m ||
-      !(yaw_var < config_.reanchor.max_yaw_sigma_rad * config_.reanchor.max_yaw_sigma_rad)) {
-    // Scattered outliers or an unconverged or diverging filter, not a jump: keep gating.
+  if (spread > config_.reanchor.max_spread_m) {
+    // Scattered outliers or a diverging filter, not a jump: keep gating.
     rejected_run_.erase(rejected_run_.begin());
+    return;
+  }
+  rejected_run_.clear();
+  const double yaw_var = filter_->rotation_covariance_world()(2, 2);
+  const double max_yaw_sigma = config_.reanchor.max_yaw_sigma_rad;
+  if (mean.norm() < config_.reanchor.min_jump_m || !(yaw_var < max_yaw_sigma * max_yaw_sigma)) {
+    // The filter, not the receiver, is off: widen the position uncertainty by the offset.
+    filter_->inflate(mean * mean.transpose(), Matrix3d::Zero());
+    ++counters_.position_inflations;
+    common::logger("estimation")
+        ->warn("{} consistent GNSS rejections ({:.2f} m): position covariance inflated",
+               config_.reanchor.after_rejections, mean.norm());
     return;
   }
   // The receiver's solution moved as a whole: shift the frame so the map stays continuous.
   anchor_offset_ += mean;
   ++counters_.reanchors;
-  rejected_run_.clear();
   common::logger("estimation")
       ->warn(
           "GNSS jump of {:.2f} m persisted for {} fixes: re-anchored (offset now {:.2f}, "

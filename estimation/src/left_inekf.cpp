@@ -237,6 +237,11 @@ CorrectionResult LeftInekf::correct_velocity(const Vector3d& velocity, const Mat
   return out;
 }
 
+void LeftInekf::inflate(const Matrix3d& position_covariance, const Matrix3d& velocity_covariance) {
+  p_.block<3, 3>(kPos, kPos) += r_.transpose() * position_covariance * r_;
+  p_.block<3, 3>(kVel, kVel) += r_.transpose() * velocity_covariance * r_;
+}
+
 NavState LeftInekf::state() const {
   NavState s;
   s.rotation = r_;

@@ -91,6 +91,12 @@ CorrectionResult QuaternionEskf::correct_velocity(const Vector3d& velocity,
   return out;
 }
 
+void QuaternionEskf::inflate(const Matrix3d& position_covariance,
+                             const Matrix3d& velocity_covariance) {
+  p_.block<3, 3>(kPos, kPos) += position_covariance;
+  p_.block<3, 3>(kVel, kVel) += velocity_covariance;
+}
+
 NavState QuaternionEskf::state() const {
   NavState s;
   s.rotation = q_.toRotationMatrix();

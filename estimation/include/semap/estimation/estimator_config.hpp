@@ -33,6 +33,12 @@ struct InitConfig {
 struct ReanchorConfig {
   int after_rejections = 10;  // consecutive rejected fixes
   double max_spread_m = 3.0;  // residuals must agree within this to count as a jump
+  // Smaller consistent offsets mean the filter is overconfident, not that GNSS jumped: the
+  // position covariance is inflated instead so that the next fix is accepted.
+  double min_jump_m = 10.0;
+  // This many consecutive rejections with scattered residuals mean the filter diverged: its
+  // position and velocity uncertainty is inflated to the size of the residuals.
+  int diverged_after_rejections = 50;
   // Only a converged filter re-anchors; an unconverged one waits for its covariance to grow.
   double max_yaw_sigma_rad = 0.1;
 };

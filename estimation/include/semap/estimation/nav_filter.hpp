@@ -32,6 +32,11 @@ class NavFilter {
   virtual CorrectionResult correct_velocity(const Eigen::Vector3d& velocity,
                                             const Eigen::Matrix3d& covariance, double gate2) = 0;
 
+  // Adds world-frame covariances to the position and velocity uncertainty (recovery from a
+  // filter that has become overconfident and gates out every fix).
+  virtual void inflate(const Eigen::Matrix3d& position_covariance,
+                       const Eigen::Matrix3d& velocity_covariance) = 0;
+
   virtual NavState state() const = 0;
   virtual const Matrix15& covariance() const = 0;
   // Error of this estimate with respect to `truth` in the filter's own error coordinates.
