@@ -1,6 +1,7 @@
 #include "semap/estimation/estimator.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "semap/common/logging.hpp"
@@ -246,7 +247,11 @@ void Estimator::note_rejection(const Vector3d& residual) {
   for (const auto& r : rejected_run_) mean += r;
   mean /= static_cast<double>(rejected_run_.size());
   double spread = 0.0;
-  for (const auto& r : rejected_run_) spread = std::max(spread, (r - mean).norm());
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const auto& r : rejected_run_) {
+    spread = std::max(spread, (r - mean).norm());
+    smallest = std::min(smallest, r.norm());
+  }
   if (spread > config_.reanchor.max_spread_m) {
     // Scattered outliers or a diverging filter, not a jump: keep gating.
     rejected_run_.erase(rejected_run_.begin());
@@ -255,7 +260,9 @@ void Estimator::note_rejection(const Vector3d& residual) {
   rejected_run_.clear();
   const double yaw_var = filter_->rotation_covariance_world()(2, 2);
   const double max_yaw_sigma = config_.reanchor.max_yaw_sigma_rad;
-  if (mean.norm() < config_.reanchor.min_jump_m || !(yaw_var < max_yaw_sigma * max_yaw_sigma)) {
+  // A receiver jump is a step: every residual of the run is already large. A filter drifting
+  // away produces residuals that start small.
+  if (smallest < config_.reanchor.min_jump_m || !(yaw_var < max_yaw_sigma * max_yaw_sigma)) {
     // The filter, not the receiver, is off: widen the position uncertainty by the offset.
     filter_->inflate(mean * mean.transpose(), Matrix3d::Zero());
     ++counters_.position_inflations;
