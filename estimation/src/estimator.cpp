@@ -1,6 +1,7 @@
 #include "semap/estimation/estimator.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "semap/common/logging.hpp"
@@ -150,16 +151,24 @@ void Estimator::try_initialise() {
   mean_gyro /= n;
   mean_accel /= n;
   double accel_var = 0.0;
-  for (const auto& s : init_window_) accel_var += (s.accel - mean_accel).squaredNorm();
+  double gyro_var = 0.0;
+  for (const auto& s : init_window_) {
+    accel_var += (s.accel - mean_accel).squaredNorm();
+    gyro_var += (s.gyro - mean_gyro).squaredNorm() / 3.0;
+  }
   accel_var /= n;
+  gyro_var /= n;
+  const double gyro_bias_sigma =
+      std::max(config_.init.min_gyro_bias_sigma_rad_s, 3.0 * std::sqrt(gyro_var / n));
   const auto& ic = config_.init;
   if (mean_gyro.norm() > ic.static_gyro_max_rad_s ||
       std::sqrt(accel_var) > ic.static_accel_std_max_m_s2) {
     ++counters_.init_not_static;
     common::logger("estimation")
-        ->warn("initialising from a window that is not static (|gyro| {:.3f} rad/s, accel std "
-               "{:.3f} m/s^2)",
-               mean_gyro.norm(), std::sqrt(accel_var));
+        ->warn(
+            "initialising from a window that is not static (|gyro| {:.3f} rad/s, accel std "
+            "{:.3f} m/s^2)",
+            mean_gyro.norm(), std::sqrt(accel_var));
   }
 
   // At rest the accelerometer measures R^T (0, 0, g): roll and pitch follow from its direction.
@@ -174,11 +183,9 @@ void Estimator::try_initialise() {
   Matrix15 p = Matrix15::Zero();
   p.block<3, 3>(kRot, kRot).diagonal() << ic.tilt_sigma_rad * ic.tilt_sigma_rad,
       ic.tilt_sigma_rad * ic.tilt_sigma_rad, ic.yaw_sigma_rad * ic.yaw_sigma_rad;
-  p.block<3, 3>(kVel, kVel) =
-      Matrix3d::Identity() * ic.velocity_sigma_m_s * ic.velocity_sigma_m_s;
+  p.block<3, 3>(kVel, kVel) = Matrix3d::Identity() * ic.velocity_sigma_m_s * ic.velocity_sigma_m_s;
   p.block<3, 3>(kPos, kPos) = init_fix_->covariance;
-  p.block<3, 3>(kGyroBias, kGyroBias) =
-      Matrix3d::Identity() * ic.gyro_bias_sigma_rad_s * ic.gyro_bias_sigma_rad_s;
+  p.block<3, 3>(kGyroBias, kGyroBias) = Matrix3d::Identity() * gyro_bias_sigma * gyro_bias_sigma;
   p.block<3, 3>(kAccelBias, kAccelBias) =
       Matrix3d::Identity() * ic.accel_bias_sigma_m_s2 * ic.accel_bias_sigma_m_s2;
   filter_->reset(x, p);
@@ -189,8 +196,8 @@ void Estimator::try_initialise() {
   record_pose();
   common::logger("estimation")
       ->info("initialised at {:.3f} s: roll {:.2f} deg, pitch {:.2f} deg, yaw guess {:.1f} deg",
-             filter_time_.seconds(), roll * 180.0 / std::numbers::pi, pitch * 180.0 / std::numbers::pi,
-             ic.yaw_rad * 180.0 / std::numbers::pi);
+             filter_time_.seconds(), roll * 180.0 / std::numbers::pi,
+             pitch * 180.0 / std::numbers::pi, ic.yaw_rad * 180.0 / std::numbers::pi);
 }
 
 void Estimator::apply_gnss(const common::GnssFix& fix) {
@@ -201,6 +208,7 @@ void Estimator::apply_gnss(const common::GnssFix& fix) {
   if (r.accepted) {
     ++counters_.gnss_applied;
     rejected_run_.clear();
+    consecutive_rejections_ = 0;
   } else {
     ++counters_.gnss_rejected;
     common::logger("estimation")
@@ -219,26 +227,59 @@ void Estimator::apply_gnss(const common::GnssFix& fix) {
 
 void Estimator::note_rejection(const Vector3d& residual) {
   rejected_run_.push_back(residual);
+  if (++consecutive_rejections_ >= config_.reanchor.diverged_after_rejections) {
+    const double var = residual.squaredNorm();
+    const double window_s = 0.1 * consecutive_rejections_;
+    filter_->inflate(Matrix3d::Identity() * var,
+                     Matrix3d::Identity() * var / (window_s * window_s));
+    ++counters_.position_inflations;
+    common::logger("estimation")
+        ->warn(
+            "{} GNSS fixes in a row gated out (residual {:.1f} m): filter diverged, position "
+            "and velocity uncertainty inflated",
+            consecutive_rejections_, residual.norm());
+    consecutive_rejections_ = 0;
+    rejected_run_.clear();
+    return;
+  }
   if (static_cast<int>(rejected_run_.size()) < config_.reanchor.after_rejections) return;
   Vector3d mean = Vector3d::Zero();
   for (const auto& r : rejected_run_) mean += r;
   mean /= static_cast<double>(rejected_run_.size());
   double spread = 0.0;
-  for (const auto& r : rejected_run_) spread = std::max(spread, (r - mean).norm());
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const auto& r : rejected_run_) {
+    spread = std::max(spread, (r - mean).norm());
+    smallest = std::min(smallest, r.norm());
+  }
   if (spread > config_.reanchor.max_spread_m) {
     // Scattered outliers or a diverging filter, not a jump: keep gating.
     rejected_run_.erase(rejected_run_.begin());
     return;
   }
+  rejected_run_.clear();
+  const double yaw_var = filter_->rotation_covariance_world()(2, 2);
+  const double max_yaw_sigma = config_.reanchor.max_yaw_sigma_rad;
+  // A receiver jump is a step: every residual of the run is already large. A filter drifting
+  // away produces residuals that start small.
+  if (smallest < config_.reanchor.min_jump_m || !(yaw_var < max_yaw_sigma * max_yaw_sigma)) {
+    // The filter, not the receiver, is off: widen the position uncertainty by the offset.
+    filter_->inflate(mean * mean.transpose(), Matrix3d::Zero());
+    ++counters_.position_inflations;
+    common::logger("estimation")
+        ->warn("{} consistent GNSS rejections ({:.2f} m): position covariance inflated",
+               config_.reanchor.after_rejections, mean.norm());
+    return;
+  }
   // The receiver's solution moved as a whole: shift the frame so the map stays continuous.
   anchor_offset_ += mean;
   ++counters_.reanchors;
-  rejected_run_.clear();
   common::logger("estimation")
-      ->warn("GNSS jump of {:.2f} m persisted for {} fixes: re-anchored (offset now {:.2f}, "
-             "{:.2f}, {:.2f})",
-             mean.norm(), config_.reanchor.after_rejections, anchor_offset_.x(),
-             anchor_offset_.y(), anchor_offset_.z());
+      ->warn(
+          "GNSS jump of {:.2f} m persisted for {} fixes: re-anchored (offset now {:.2f}, "
+          "{:.2f}, {:.2f})",
+          mean.norm(), config_.reanchor.after_rejections, anchor_offset_.x(), anchor_offset_.y(),
+          anchor_offset_.z());
 }
 
 void Estimator::record_pose() {

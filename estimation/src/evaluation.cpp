@@ -82,8 +82,8 @@ EvaluationMetrics score(const std::vector<EvaluationSample>& samples,
   if (samples.size() >= 2) {
     const double rate = static_cast<double>(samples.size() - 1) /
                         std::max(1e-9, samples.back().t - samples.front().t);
-    m.rpe = relative_pose_error(est, truth,
-                                static_cast<std::size_t>(std::lround(kRpeSeconds * rate)));
+    m.rpe =
+        relative_pose_error(est, truth, static_cast<std::size_t>(std::lround(kRpeSeconds * rate)));
   }
   m.mean_nees = nees_sum / static_cast<double>(est.size());
   return m;

@@ -28,15 +28,14 @@ LocalEnu& LocalEnu::operator=(const LocalEnu& other) {
 
 Eigen::Vector3d LocalEnu::to_enu(const Geodetic& point) const {
   Eigen::Vector3d enu;
-  impl_->frame.Forward(point.latitude_deg, point.longitude_deg, point.altitude_m, enu.x(),
-                       enu.y(), enu.z());
+  impl_->frame.Forward(point.latitude_deg, point.longitude_deg, point.altitude_m, enu.x(), enu.y(),
+                       enu.z());
   return enu;
 }
 
 Geodetic LocalEnu::to_geodetic(const Eigen::Vector3d& enu) const {
   Geodetic g;
-  impl_->frame.Reverse(enu.x(), enu.y(), enu.z(), g.latitude_deg, g.longitude_deg,
-                       g.altitude_m);
+  impl_->frame.Reverse(enu.x(), enu.y(), enu.z(), g.latitude_deg, g.longitude_deg, g.altitude_m);
   return g;
 }
 

@@ -9,9 +9,9 @@ bool GnssReorderBuffer::push(const common::GnssFix& fix, common::Stamp filter_ti
     ++counters_.late;
     return false;
   }
-  const auto at = std::lower_bound(
-      fixes_.begin(), fixes_.end(), fix.stamp,
-      [](const common::GnssFix& f, common::Stamp s) { return f.stamp < s; });
+  const auto at =
+      std::lower_bound(fixes_.begin(), fixes_.end(), fix.stamp,
+                       [](const common::GnssFix& f, common::Stamp s) { return f.stamp < s; });
   if (at != fixes_.end() && at->stamp == fix.stamp) {
     ++counters_.duplicate;
     return false;

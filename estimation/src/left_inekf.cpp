@@ -21,34 +21,49 @@ constexpr unsigned kNormaliseEvery = 256;
 constexpr std::array<double, 3> kNodes = {0.1127016653792583, 0.5, 0.8872983346207417};
 constexpr std::array<double, 3> kWeights = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
 
-// Phi = diag(omega) * (Phi_top rows) applied to the 15 x C matrix x; returns rows 0..8.
-template <int C>
-Eigen::Matrix<double, 9, C> phi_top_times(const LeftInekfTransition& b,
-                                          const Eigen::Matrix<double, 15, C>& x) {
-  Eigen::Matrix<double, 9, C> out;
-  const auto x1 = x.template middleRows<3>(kRot);
-  const auto x2 = x.template middleRows<3>(kVel);
-  const auto x3 = x.template middleRows<3>(kPos);
-  const auto x4 = x.template middleRows<3>(kGyroBias);
-  const auto x5 = x.template middleRows<3>(kAccelBias);
-  const Eigen::Matrix<double, 3, C> x23 = b.dt * x2 + x3;
-  out.template middleRows<3>(0).noalias() = b.omega * x1;
-  out.template middleRows<3>(0).noalias() += b.f14 * x4;
-  out.template middleRows<3>(3).noalias() = b.f21 * x1;
-  out.template middleRows<3>(3).noalias() += b.omega * x2;
-  out.template middleRows<3>(3).noalias() += b.f24 * x4;
-  out.template middleRows<3>(3).noalias() += b.f25 * x5;
-  out.template middleRows<3>(6).noalias() = b.f31 * x1;
-  out.template middleRows<3>(6).noalias() += b.omega * x23;
-  out.template middleRows<3>(6).noalias() += b.f34 * x4;
-  out.template middleRows<3>(6).noalias() += b.f35 * x5;
+// out (=|+=) x m^T for R x 3 column blocks, written as column AXPYs: each is a whole-column
+// vector operation that Eigen vectorises (the generic small-product path stays scalar here).
+template <typename Out, typename In>
+void set_product(Out&& out, const In& x, const Eigen::Matrix3d& m) {
+  for (int c = 0; c < 3; ++c) {
+    out.col(c) = x.col(0) * m(c, 0) + x.col(1) * m(c, 1) + x.col(2) * m(c, 2);
+  }
+}
+template <typename Out, typename In>
+void add_product(Out&& out, const In& x, const Eigen::Matrix3d& m) {
+  for (int c = 0; c < 3; ++c) {
+    out.col(c) += x.col(0) * m(c, 0) + x.col(1) * m(c, 1) + x.col(2) * m(c, 2);
+  }
+}
+
+// X Phi_top^T for X with 15 columns (R rows): block column i of the result is
+// sum_j X[:, j] Phi_ij^T. R is kept even so every column is whole SIMD packets.
+template <int R>
+Eigen::Matrix<double, R, 9> times_phi_top_transposed(const LeftInekfTransition& b,
+                                                     const Eigen::Matrix<double, R, 15>& x) {
+  Eigen::Matrix<double, R, 9> out;
+  const auto x1 = x.template middleCols<3>(kRot);
+  const auto x2 = x.template middleCols<3>(kVel);
+  const auto x3 = x.template middleCols<3>(kPos);
+  const auto x4 = x.template middleCols<3>(kGyroBias);
+  const auto x5 = x.template middleCols<3>(kAccelBias);
+  const Eigen::Matrix<double, R, 3> x23 = b.dt * x2 + x3;
+  set_product(out.template middleCols<3>(0), x1, b.omega);
+  add_product(out.template middleCols<3>(0), x4, b.f14);
+  set_product(out.template middleCols<3>(3), x1, b.f21);
+  add_product(out.template middleCols<3>(3), x2, b.omega);
+  add_product(out.template middleCols<3>(3), x4, b.f24);
+  add_product(out.template middleCols<3>(3), x5, b.f25);
+  set_product(out.template middleCols<3>(6), x1, b.f31);
+  add_product(out.template middleCols<3>(6), x23, b.omega);
+  add_product(out.template middleCols<3>(6), x4, b.f34);
+  add_product(out.template middleCols<3>(6), x5, b.f35);
   return out;
 }
 
 }  // namespace
 
-LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector3d& a,
-                                                 double dt) {
+LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector3d& a, double dt) {
   LeftInekfTransition b;
   b.dt = dt;
   const Vector3d phi = w * dt;
@@ -130,14 +145,21 @@ void LeftInekf::reset(const NavState& state, const Matrix15& world_covariance) {
 }
 
 void LeftInekf::apply_transition(const LeftInekfTransition& phi) {
-  // Y = Phi P (rows 9..14 of Phi are [0 I]); P- = Phi Y^T, of which only the top-left 9x9
-  // needs new work: the top-right 9x6 is Y's, the bias block is unchanged.
-  const Eigen::Matrix<double, 9, 15> y_top = phi_top_times<15>(phi, p_);
-  const Eigen::Matrix<double, 15, 9> y_top_t = y_top.transpose();
-  const Eigen::Matrix<double, 9, 9> tl = phi_top_times<9>(phi, y_top_t);
-  p_.topLeftCorner<9, 9>() = 0.5 * (tl + tl.transpose());
-  p_.topRightCorner<9, 6>() = y_top.rightCols<6>();
-  p_.bottomLeftCorner<6, 9>() = y_top.rightCols<6>().transpose();
+  // With Phi = [[F, G], [0, I]] (F, G: rows 0..8), P- = Phi P Phi^T has
+  //   top-right 9x6 = (P Phi_top^T)[9..14, :]^T and top-left 9x9 = Phi_top (P Phi_top^T),
+  // and an unchanged bias block. Both products are formed as X Phi_top^T, on copies padded
+  // to an even row count so that every column is whole SIMD packets.
+  Eigen::Matrix<double, 16, 15> padded;
+  padded.topRows<15>() = p_;
+  padded.row(15).setZero();
+  const Eigen::Matrix<double, 16, 9> y = times_phi_top_transposed<16>(phi, padded);
+  Eigen::Matrix<double, 10, 15> y_t;
+  y_t.topRows<9>() = y.topRows<15>().transpose();
+  y_t.row(9).setZero();
+  const Eigen::Matrix<double, 10, 9> tl = times_phi_top_transposed<10>(phi, y_t);
+  p_.topLeftCorner<9, 9>() = 0.5 * (tl.topRows<9>() + tl.topRows<9>().transpose());
+  p_.bottomLeftCorner<6, 9>() = y.middleRows<6>(9);
+  p_.topRightCorner<9, 6>() = y.middleRows<6>(9).transpose();
 }
 
 void LeftInekf::propagate(const Vector3d& gyro, const Vector3d& accel, double dt) {
@@ -182,8 +204,7 @@ void LeftInekf::retract(const Vector15& delta) {
   ba_ += delta.segment<3>(kAccelBias);
 }
 
-CorrectionResult LeftInekf::correct_position(const Vector3d& position,
-                                             const Matrix3d& covariance,
+CorrectionResult LeftInekf::correct_position(const Vector3d& position, const Matrix3d& covariance,
                                              const Vector3d& lever_arm, double gate2) {
   // Y = X b with b = (lever, 0, 1): innovation X^-1 Y - b = R^T (y - p) - lever, which is
   // xi_p - [lever]x xi_R to first order, with noise R^T N R.
@@ -214,6 +235,11 @@ CorrectionResult LeftInekf::correct_velocity(const Vector3d& velocity, const Mat
   out.mahalanobis2 = u.mahalanobis2;
   if (u.accepted) retract(u.delta);
   return out;
+}
+
+void LeftInekf::inflate(const Matrix3d& position_covariance, const Matrix3d& velocity_covariance) {
+  p_.block<3, 3>(kPos, kPos) += r_.transpose() * position_covariance * r_;
+  p_.block<3, 3>(kVel, kVel) += r_.transpose() * velocity_covariance * r_;
 }
 
 NavState LeftInekf::state() const {

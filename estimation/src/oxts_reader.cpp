@@ -17,10 +17,10 @@ namespace semap::estimation {
 namespace {
 
 constexpr std::array<const char*, kOxtsFields> kFieldNames = {
-    "lat",  "lon", "alt", "roll", "pitch", "yaw", "vn", "ve", "vf", "vl",
-    "vu",   "ax",  "ay",  "az",   "af",    "al",  "au", "wx", "wy", "wz",
-    "wf",   "wl",  "wu",  "pos_accuracy", "vel_accuracy", "navstat", "numsats", "posmode",
-    "velmode", "orimode"};
+    "lat",          "lon",     "alt",     "roll",    "pitch",   "yaw",    "vn", "ve",
+    "vf",           "vl",      "vu",      "ax",      "ay",      "az",     "af", "al",
+    "au",           "wx",      "wy",      "wz",      "wf",      "wl",     "wu", "pos_accuracy",
+    "vel_accuracy", "navstat", "numsats", "posmode", "velmode", "orimode"};
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
@@ -43,7 +43,8 @@ std::optional<OxtsRecord> parse_oxts_line(std::string_view line, std::string& er
     const auto [ptr, ec] = std::from_chars(line.data() + pos, line.data() + end, value);
     if (ec != std::errc() || ptr != line.data() + end || !std::isfinite(value)) {
       error = "field " + std::to_string(field + 1) + " (" + kFieldNames[field] +
-              "): not a finite number: '" + std::string(line.substr(pos, std::min<std::size_t>(end - pos, 32))) + "'";
+              "): not a finite number: '" +
+              std::string(line.substr(pos, std::min<std::size_t>(end - pos, 32))) + "'";
       return std::nullopt;
     }
     v[field++] = value;
@@ -75,8 +76,8 @@ std::optional<OxtsRecord> parse_oxts_line(std::string_view line, std::string& er
 std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text) {
   while (!text.empty() && is_space(text.back())) text.remove_suffix(1);
   // YYYY-MM-DD HH:MM:SS[.fraction]
-  if (text.size() < 19 || text[4] != '-' || text[7] != '-' || text[10] != ' ' ||
-      text[13] != ':' || text[16] != ':') {
+  if (text.size() < 19 || text[4] != '-' || text[7] != '-' || text[10] != ' ' || text[13] != ':' ||
+      text[16] != ':') {
     return std::nullopt;
   }
   auto number = [&](std::size_t at, std::size_t len, int& out) {
@@ -84,12 +85,12 @@ std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text) {
     return ec == std::errc() && ptr == text.data() + at + len;
   };
   int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
-  if (!number(0, 4, year) || !number(5, 2, month) || !number(8, 2, day) ||
-      !number(11, 2, hour) || !number(14, 2, minute) || !number(17, 2, second)) {
+  if (!number(0, 4, year) || !number(5, 2, month) || !number(8, 2, day) || !number(11, 2, hour) ||
+      !number(14, 2, minute) || !number(17, 2, second)) {
     return std::nullopt;
   }
-  if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 ||
-      second > 60 || year < 1970) {
+  if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60 ||
+      year < 1970) {
     return std::nullopt;
   }
   std::int64_t nanos = 0;
@@ -123,7 +124,8 @@ OxtsData read_oxts_folder(const std::filesystem::path& dir) {
   }
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(data_dir)) {
-    if (entry.is_regular_file() && entry.path().extension() == ".txt") files.push_back(entry.path());
+    if (entry.is_regular_file() && entry.path().extension() == ".txt")
+      files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
 

@@ -40,7 +40,8 @@ std::optional<StampedPose> PoseHistory::at(common::Stamp stamp) const {
   const StampedPose& b = get(lo);
   if (b.stamp == stamp || lo == 0) return b;
   const StampedPose& a = get(lo - 1);
-  const double f = common::seconds_between(stamp, a.stamp) / common::seconds_between(b.stamp, a.stamp);
+  const double f =
+      common::seconds_between(stamp, a.stamp) / common::seconds_between(b.stamp, a.stamp);
   StampedPose out;
   out.stamp = stamp;
   out.orientation = a.orientation.slerp(f, b.orientation);

@@ -10,9 +10,7 @@ namespace {
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
-Eigen::Quaterniond quaternion_exp(const Vector3d& phi) {
-  return Eigen::Quaterniond(gamma0(phi));
-}
+Eigen::Quaterniond quaternion_exp(const Vector3d& phi) { return Eigen::Quaterniond(gamma0(phi)); }
 }  // namespace
 
 QuaternionEskf::QuaternionEskf(const FilterParams& params)
@@ -91,6 +89,12 @@ CorrectionResult QuaternionEskf::correct_velocity(const Vector3d& velocity,
   out.mahalanobis2 = u.mahalanobis2;
   if (u.accepted) inject(u.delta);
   return out;
+}
+
+void QuaternionEskf::inflate(const Matrix3d& position_covariance,
+                             const Matrix3d& velocity_covariance) {
+  p_.block<3, 3>(kPos, kPos) += position_covariance;
+  p_.block<3, 3>(kVel, kVel) += velocity_covariance;
 }
 
 NavState QuaternionEskf::state() const {

@@ -96,7 +96,7 @@ Kinematics rk4(const Profile& p, const Kinematics& k, double t, double h) {
 }
 
 struct Motion {
-  NavState state;  // without biases
+  NavState state;                    // without biases
   Vector3d gyro = Vector3d::Zero();  // true body rate
   Vector3d specific_force = Vector3d::Zero();
 };
@@ -166,7 +166,8 @@ SimulationData simulate(const SimulatorConfig& c) {
           const Motion mg = motion_at(profile, kg, tg, c.gravity);
           next_gnss += 1.0 / c.gnss_rate_hz;
           while (next_dropout_check <= tg) {
-            if (uniform(rng) < c.dropouts_per_minute / 60.0) dropout_until = tg + c.dropout_duration_s;
+            if (uniform(rng) < c.dropouts_per_minute / 60.0)
+              dropout_until = tg + c.dropout_duration_s;
             next_dropout_check += 1.0;
           }
           if (tg >= dropout_until) {

@@ -21,22 +21,24 @@ GammaCoefficients gamma_coefficients(double theta) {
   if (theta < kSeriesBelow) {
     const double t4 = t2 * t2;
     const double t6 = t4 * t2;
-    const double sinc = 1.0 - t2 / 6.0 + t4 / 120.0 - t6 / 5040.0;                // sin/t
-    const double cosc = 0.5 - t2 / 24.0 + t4 / 720.0 - t6 / 40320.0;              // (1-cos)/t^2
-    const double sinc3 = 1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 - t6 / 362880.0;    // (t-sin)/t^3
-    const double cosc4 = 1.0 / 24.0 - t2 / 720.0 + t4 / 40320.0 - t6 / 3628800.0;  // (t^2+2cos-2)/(2t^4)
+    const double sinc = 1.0 - t2 / 6.0 + t4 / 120.0 - t6 / 5040.0;              // sin/t
+    const double cosc = 0.5 - t2 / 24.0 + t4 / 720.0 - t6 / 40320.0;            // (1-cos)/t^2
+    const double sinc3 = 1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 - t6 / 362880.0;  // (t-sin)/t^3
+    const double cosc4 =
+        1.0 / 24.0 - t2 / 720.0 + t4 / 40320.0 - t6 / 3628800.0;  // (t^2+2cos-2)/(2t^4)
     c = {sinc, cosc, cosc, sinc3, sinc3, cosc4};
     return c;
   }
+  // Half-angle forms avoid the cancellation in 1 - cos and in t^2 + 2 cos - 2.
   const double s = std::sin(theta);
-  const double co = std::cos(theta);
+  const double sh = std::sin(0.5 * theta);
   const double t3 = t2 * theta;
   c.a0 = s / theta;
-  c.b0 = (1.0 - co) / t2;
+  c.b0 = 2.0 * sh * sh / t2;
   c.a1 = c.b0;
   c.b1 = (theta - s) / t3;
   c.a2 = c.b1;
-  c.b2 = (t2 + 2.0 * co - 2.0) / (2.0 * t2 * t2);
+  c.b2 = (theta - 2.0 * sh) * (theta + 2.0 * sh) / (2.0 * t2 * t2);
   return c;
 }
 
@@ -78,7 +80,9 @@ Eigen::Vector3d so3_log(const Eigen::Matrix3d& rotation) {
   return q.vec() * (angle / vn);
 }
 
-double yaw_of(const Eigen::Matrix3d& rotation) { return std::atan2(rotation(1, 0), rotation(0, 0)); }
+double yaw_of(const Eigen::Matrix3d& rotation) {
+  return std::atan2(rotation(1, 0), rotation(0, 0));
+}
 
 Eigen::Matrix3d rotation_from_rpy(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *

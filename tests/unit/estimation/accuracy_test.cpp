@@ -42,11 +42,11 @@ Figures drive(FilterKind kind) {
     nees.push_back(std::move(series));
   }
   f.nees = summarise_nees(nees, 9);
-  std::printf("[%s] 10-min drive: ATE %.3f m, heading RMSE %.3f deg, ANEES %.2f (95%% bounds "
-              "%.2f..%.2f over %d runs), inside %.0f%% of steps\n",
-              kind == FilterKind::kLeftInekf ? "InEKF" : "ESKF", f.ate, f.heading,
-              f.nees.average, f.nees.lower_bound, f.nees.upper_bound, kRuns,
-              100.0 * f.nees.fraction_inside);
+  std::printf(
+      "[%s] 10-min drive: ATE %.3f m, heading RMSE %.3f deg, ANEES %.2f (95%% bounds "
+      "%.2f..%.2f over %d runs), inside %.0f%% of steps\n",
+      kind == FilterKind::kLeftInekf ? "InEKF" : "ESKF", f.ate, f.heading, f.nees.average,
+      f.nees.lower_bound, f.nees.upper_bound, kRuns, 100.0 * f.nees.fraction_inside);
   return f;
 }
 
@@ -78,9 +78,10 @@ TEST(Accuracy, HeadingConvergesFrom180Degrees) {
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     const double inekf = settle_from_180(FilterKind::kLeftInekf, seed);
     const double eskf = settle_from_180(FilterKind::kQuaternionEskf, seed);
-    std::printf("seed %lu, 180 deg initial heading error: below 2 deg after %.1f s of driving "
-                "(InEKF), %s (ESKF: %.1f s)\n",
-                static_cast<unsigned long>(seed), inekf, eskf < 0 ? "never" : "settled", eskf);
+    std::printf(
+        "seed %lu, 180 deg initial heading error: below 2 deg after %.1f s of driving "
+        "(InEKF), %s (ESKF: %.1f s)\n",
+        static_cast<unsigned long>(seed), inekf, eskf < 0 ? "never" : "settled", eskf);
     EXPECT_GE(inekf, 0.0);
     EXPECT_LT(inekf, 20.0);
   }

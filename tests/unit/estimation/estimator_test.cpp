@@ -261,7 +261,7 @@ TEST(Estimator, InterpolatesPoseFromHistory) {
   const auto mid = e.pose_at(Stamp((a.ns + b.ns) / 2));
   ASSERT_TRUE(pa && pb && mid);
   EXPECT_LT((mid->position - 0.5 * (pa->position + pb->position)).norm(), 1e-9);
-  EXPECT_LT(mid->orientation.angularDistance(pa->orientation), 
+  EXPECT_LT(mid->orientation.angularDistance(pa->orientation),
             pa->orientation.angularDistance(pb->orientation) + 1e-12);
   EXPECT_FALSE(e.pose_at(data.imu.back().stamp + 1.0).has_value());
   EXPECT_FALSE(e.pose_at(data.imu.front().stamp).has_value());  // older than the history

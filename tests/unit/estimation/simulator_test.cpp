@@ -56,8 +56,8 @@ TEST(Simulator, GnssRateDropoutsJumpsAndOrdering) {
   for (std::size_t i = 1; i < d.imu.size(); ++i) EXPECT_LT(d.imu[i - 1].stamp, d.imu[i].stamp);
   const LocalEnu enu(d.origin);
   // Fix 0 at rest: the antenna sits lever_arm above the body origin.
-  const Vector3d p0 = enu.to_enu({d.gnss[0].latitude_deg, d.gnss[0].longitude_deg,
-                                  d.gnss[0].altitude_m});
+  const Vector3d p0 =
+      enu.to_enu({d.gnss[0].latitude_deg, d.gnss[0].longitude_deg, d.gnss[0].altitude_m});
   EXPECT_LT((p0 - (d.truth[0].state.position + Vector3d(0, 0, 1.5))).norm(), 1e-3);
   int jumped = 0;
   for (const auto& f : d.gnss) {

@@ -28,8 +28,8 @@ NumericGammas numeric(const Vector3d& phi) {
 std::vector<Vector3d> test_angles() {
   const Vector3d axis = Vector3d(0.3, -0.5, 0.8).normalized();
   std::vector<Vector3d> out;
-  for (double theta : {0.0, 1e-12, 1e-8, 1e-5, 1e-3, 0.0999999, 0.1, 0.1000001, 0.5, 1.5, 3.0,
-                       3.14159}) {
+  for (double theta :
+       {0.0, 1e-12, 1e-8, 1e-5, 1e-3, 0.0999999, 0.1, 0.1000001, 0.5, 1.5, 3.0, 3.14159}) {
     out.push_back(axis * theta);
   }
   return out;

@@ -21,13 +21,14 @@ struct EstimatorCounters {
   ImuCounters imu;
   GnssBufferCounters gnss_buffer;
   std::uint64_t gnss_received = 0;
-  std::uint64_t gnss_invalid = 0;   // no fix, non-finite values or a bad covariance
+  std::uint64_t gnss_invalid = 0;  // no fix, non-finite values or a bad covariance
   std::uint64_t gnss_applied = 0;
   std::uint64_t gnss_rejected = 0;  // failed the chi-square gate
   std::uint64_t velocity_applied = 0;
   std::uint64_t velocity_rejected = 0;
   std::uint64_t reanchors = 0;
-  std::uint64_t init_not_static = 0;  // initialised from a window that was not at rest
+  std::uint64_t position_inflations = 0;  // overconfident or diverged filter recovered
+  std::uint64_t init_not_static = 0;      // initialised from a window that was not at rest
 };
 
 // The current filter output.
@@ -96,6 +97,7 @@ class Estimator {
   bool initialised_ = false;
   common::Stamp filter_time_;
   std::vector<Eigen::Vector3d> rejected_run_;  // residuals of consecutive gated-out fixes
+  int consecutive_rejections_ = 0;
 };
 
 std::unique_ptr<NavFilter> make_filter(FilterKind kind, const FilterParams& params);

@@ -15,13 +15,16 @@ enum class FilterKind : std::uint8_t { kLeftInekf, kQuaternionEskf };
 
 // Initialisation from a static IMU window plus the first GNSS fix.
 struct InitConfig {
-  double window_s = 1.0;             // static IMU window length
-  double yaw_rad = 0.0;              // heading guess; any error must converge from motion
-  double yaw_sigma_rad = 3.0;        // ~ uniform over the circle
+  double window_s = 1.0;       // static IMU window length
+  double yaw_rad = 0.0;        // heading guess; any error must converge from motion
+  double yaw_sigma_rad = 3.0;  // ~ uniform over the circle
   double tilt_sigma_rad = 0.03;
   double velocity_sigma_m_s = 0.2;
-  double gyro_bias_sigma_rad_s = 0.01;
-  double accel_bias_sigma_m_s2 = 0.2;
+  // The gyro bias comes from the window mean; its sigma is 3x the standard error of that mean,
+  // never below this floor. An honest small sigma keeps a large initial heading error from
+  // being absorbed into the gyro bias while the heading converges.
+  double min_gyro_bias_sigma_rad_s = 2e-4;
+  double accel_bias_sigma_m_s2 = 0.1;
   double static_gyro_max_rad_s = 0.05;  // mean |gyro| above this: not static (warned, counted)
   double static_accel_std_max_m_s2 = 0.3;
 };
@@ -30,6 +33,14 @@ struct InitConfig {
 struct ReanchorConfig {
   int after_rejections = 10;  // consecutive rejected fixes
   double max_spread_m = 3.0;  // residuals must agree within this to count as a jump
+  // Smaller consistent offsets mean the filter is overconfident, not that GNSS jumped: the
+  // position covariance is inflated instead so that the next fix is accepted.
+  double min_jump_m = 10.0;
+  // This many consecutive rejections with scattered residuals mean the filter diverged: its
+  // position and velocity uncertainty is inflated to the size of the residuals.
+  int diverged_after_rejections = 50;
+  // Only a converged filter re-anchors; an unconverged one waits for its covariance to grow.
+  double max_yaw_sigma_rad = 0.1;
 };
 
 struct EstimatorConfig {

@@ -10,9 +10,9 @@
 namespace semap::estimation {
 
 struct GnssBufferCounters {
-  std::uint64_t late = 0;        // older than the filter time: would be applied out of order
-  std::uint64_t duplicate = 0;   // same stamp as a buffered fix
-  std::uint64_t overflow = 0;    // buffer full, oldest dropped
+  std::uint64_t late = 0;       // older than the filter time: would be applied out of order
+  std::uint64_t duplicate = 0;  // same stamp as a buffered fix
+  std::uint64_t overflow = 0;   // buffer full, oldest dropped
 };
 
 // Holds GNSS fixes sorted by stamp until the filter time passes them, so fixes that arrive

@@ -8,8 +8,8 @@
 namespace semap::estimation {
 
 struct ImuLimits {
-  double max_dt_s = 0.1;         // larger gaps are not integrated
-  double max_gyro_rad_s = 35.0;  // ~2000 deg/s full scale
+  double max_dt_s = 0.1;          // larger gaps are not integrated
+  double max_gyro_rad_s = 35.0;   // ~2000 deg/s full scale
   double max_accel_m_s2 = 160.0;  // ~16 g full scale
 };
 
@@ -22,7 +22,14 @@ struct ImuCounters {
   std::uint64_t rejected() const { return non_increasing_stamp + gap + not_finite + out_of_range; }
 };
 
-enum class ImuVerdict : std::uint8_t { kAccept, kFirst, kNonIncreasing, kGap, kNotFinite, kOutOfRange };
+enum class ImuVerdict : std::uint8_t {
+  kAccept,
+  kFirst,
+  kNonIncreasing,
+  kGap,
+  kNotFinite,
+  kOutOfRange
+};
 
 // Checks each IMU sample against the previous accepted one. kAccept comes with the dt to
 // integrate; kFirst and kGap mean "accepted as a new time reference, nothing to integrate".

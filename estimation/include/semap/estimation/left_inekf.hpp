@@ -16,8 +16,7 @@ struct LeftInekfTransition {
   double dt = 0.0;
 
   // The transition for bias-corrected rates w and accelerations a held over dt.
-  static LeftInekfTransition compute(const Eigen::Vector3d& w, const Eigen::Vector3d& a,
-                                     double dt);
+  static LeftInekfTransition compute(const Eigen::Vector3d& w, const Eigen::Vector3d& a, double dt);
   Matrix15 dense() const;
 };
 
@@ -41,6 +40,9 @@ class LeftInekf final : public NavFilter {
                                     const Eigen::Vector3d& lever_arm, double gate2) override;
   CorrectionResult correct_velocity(const Eigen::Vector3d& velocity,
                                     const Eigen::Matrix3d& covariance, double gate2) override;
+
+  void inflate(const Eigen::Matrix3d& position_covariance,
+               const Eigen::Matrix3d& velocity_covariance) override;
 
   NavState state() const override;
   const Matrix15& covariance() const override { return p_; }

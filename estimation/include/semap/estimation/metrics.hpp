@@ -31,8 +31,8 @@ RelativePoseError relative_pose_error(const std::vector<Pose3>& estimate,
 double nees(const Eigen::VectorXd& error, const Eigen::MatrixXd& covariance);
 
 struct NeesSummary {
-  double average = 0.0;       // mean over time of the NEES averaged over runs
-  double lower_bound = 0.0;   // two-sided 95 % chi-square bounds of a runs-average
+  double average = 0.0;      // mean over time of the NEES averaged over runs
+  double lower_bound = 0.0;  // two-sided 95 % chi-square bounds of a runs-average
   double upper_bound = 0.0;
   double fraction_inside = 0.0;  // of the time steps
   int dof = 0;

@@ -9,7 +9,7 @@ namespace semap::estimation {
 // Outcome of one measurement update.
 struct CorrectionResult {
   bool accepted = false;
-  double mahalanobis2 = 0.0;                         // squared Mahalanobis distance
+  double mahalanobis2 = 0.0;                           // squared Mahalanobis distance
   Eigen::Vector3d residual = Eigen::Vector3d::Zero();  // measured - predicted, world frame
 };
 
@@ -22,8 +22,7 @@ class NavFilter {
 
   virtual void reset(const NavState& state, const Matrix15& covariance) = 0;
   // Zero-order hold of the raw IMU sample (body frame) over dt seconds.
-  virtual void propagate(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel,
-                         double dt) = 0;
+  virtual void propagate(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, double dt) = 0;
   // GNSS antenna position in the world frame, its covariance (world) and the antenna lever arm
   // (body). The update is applied only when the Mahalanobis distance is below gate2.
   virtual CorrectionResult correct_position(const Eigen::Vector3d& position,
@@ -32,6 +31,11 @@ class NavFilter {
   // Velocity of the body origin in the world frame.
   virtual CorrectionResult correct_velocity(const Eigen::Vector3d& velocity,
                                             const Eigen::Matrix3d& covariance, double gate2) = 0;
+
+  // Adds world-frame covariances to the position and velocity uncertainty (recovery from a
+  // filter that has become overconfident and gates out every fix).
+  virtual void inflate(const Eigen::Matrix3d& position_covariance,
+                       const Eigen::Matrix3d& velocity_covariance) = 0;
 
   virtual NavState state() const = 0;
   virtual const Matrix15& covariance() const = 0;

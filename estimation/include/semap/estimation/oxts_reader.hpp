@@ -20,9 +20,9 @@ struct OxtsRecord {
   double latitude_deg = 0.0;
   double longitude_deg = 0.0;
   double altitude_m = 0.0;
-  double roll = 0.0;   // rad
-  double pitch = 0.0;  // rad
-  double yaw = 0.0;    // rad, 0 = east, counter-clockwise
+  double roll = 0.0;                                       // rad
+  double pitch = 0.0;                                      // rad
+  double yaw = 0.0;                                        // rad, 0 = east, counter-clockwise
   Eigen::Vector3d velocity_enu = Eigen::Vector3d::Zero();  // (ve, vn, vu)
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();         // (ax, ay, az), includes gravity
   Eigen::Vector3d gyro = Eigen::Vector3d::Zero();          // (wx, wy, wz)

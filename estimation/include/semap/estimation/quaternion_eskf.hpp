@@ -24,6 +24,9 @@ class QuaternionEskf final : public NavFilter {
   CorrectionResult correct_velocity(const Eigen::Vector3d& velocity,
                                     const Eigen::Matrix3d& covariance, double gate2) override;
 
+  void inflate(const Eigen::Matrix3d& position_covariance,
+               const Eigen::Matrix3d& velocity_covariance) override;
+
   NavState state() const override;
   const Matrix15& covariance() const override { return p_; }
   Vector15 error_from(const NavState& truth) const override;

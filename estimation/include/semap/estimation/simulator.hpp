@@ -27,11 +27,11 @@ struct SimulatorConfig {
   double speed_m_s = 10.0;
   double imu_rate_hz = 100.0;
   double gnss_rate_hz = 10.0;
-  double gnss_phase_s = 0.003;  // fixes fall between IMU samples, as on real hardware
-  ImuNoise imu_noise;           // also drives the bias random walk
-  double initial_gyro_bias_sigma = 0.005;   // rad/s
-  double initial_accel_bias_sigma = 0.05;   // m/s^2
-  double gnss_sigma_m = 1.0;                // per axis
+  double gnss_phase_s = 0.003;             // fixes fall between IMU samples, as on real hardware
+  ImuNoise imu_noise;                      // also drives the bias random walk
+  double initial_gyro_bias_sigma = 0.005;  // rad/s
+  double initial_accel_bias_sigma = 0.05;  // m/s^2
+  double gnss_sigma_m = 1.0;               // per axis
   bool gnss_velocity = false;
   double gnss_velocity_sigma_m_s = 0.1;
   double dropouts_per_minute = 0.0;

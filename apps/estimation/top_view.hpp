@@ -1,0 +1,23 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "semap/estimation/evaluation.hpp"
+
+namespace semap::apps {
+
+struct LabelledRun {
+  std::string label;
+  const estimation::EvaluationRun* run;
+};
+
+// Top view (east right, north up) of the truth, each estimate and the GNSS fixes, as PNG.
+void write_top_view(const std::filesystem::path& path, const estimation::SimulationData& data,
+                    const std::vector<LabelledRun>& runs);
+
+// One row per sample and filter: t, truth and estimated position and yaw, heading error, NEES.
+void write_csv(const std::filesystem::path& path, const std::vector<LabelledRun>& runs);
+
+}  // namespace semap::apps
