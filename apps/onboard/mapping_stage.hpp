@@ -50,7 +50,7 @@ class MappingStage {
   common::SpscRing<common::LabeledCloud>& clouds_;
   BlockSink sink_;
   mapping::SemanticMap map_;
-  std::unordered_map<mapping::BlockIndex, std::uint32_t, mapping::BlockIndexHash> versions_;
+  std::unordered_map<dds_idl::BlockIndex, std::uint32_t, dds_idl::BlockIndexHash> versions_;
   MappingStageStats local_;
   mutable std::mutex stats_mutex_;
   MappingStageStats shared_;
