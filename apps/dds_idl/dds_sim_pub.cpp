@@ -62,18 +62,19 @@ int main(int argc, char** argv) {
   try {
     semap::apps::install_stop_handlers();
     const sd::Participant participant = dds.participant();
-    map_cfg.ns = dds.ns;
+    map_cfg.ns = dds.settings().ns;
     sd::MapPublisher map(participant, map_cfg, desc);
-    sd::Topic<sd::msg::Odometry> topic(participant,
-                                       sd::topic_name(dds.ns, sd::SemapTopic::kOdometry));
+    sd::Topic<sd::msg::Odometry> topic(
+        participant, sd::topic_name(dds.settings().ns, sd::SemapTopic::kOdometry));
     sd::Writer<sd::msg::Odometry> odom(participant, topic,
                                        sd::topic_qos(sd::SemapTopic::kOdometry));
     const std::string frame = "map";
     const std::string child = "base_link";
     std::unordered_map<sd::BlockIndex, std::uint32_t, sd::BlockIndexHash> versions;
     const auto start = std::chrono::steady_clock::now();
-    std::cout << "publishing on " << sd::topic_name(dds.ns, sd::SemapTopic::kOdometry) << " and "
-              << sd::topic_name(dds.ns, sd::SemapTopic::kMapBlocks) << std::endl;
+    std::cout << "publishing on " << sd::topic_name(dds.settings().ns, sd::SemapTopic::kOdometry)
+              << " and " << sd::topic_name(dds.settings().ns, sd::SemapTopic::kMapBlocks)
+              << std::endl;
     while (!semap::apps::stop_requested()) {
       const double t =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -24,9 +24,7 @@ int main(int argc, char** argv) {
 
   try {
     const auto root = semap::common::ConfigSection::load_file(config_path);
-    const auto dds_section = root.section("dds");
-    dds.read(dds_section, app);
-    dds_section.finish();
+    dds.read(root.section("dds"), app);
     const auto f = root.section("fusion");
     sd::MapFusionConfig cfg;
     cfg.robots = f.get<std::vector<std::string>>("robots");

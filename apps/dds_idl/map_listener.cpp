@@ -38,16 +38,16 @@ int main(int argc, char** argv) {
     semap::apps::install_stop_handlers();
     const sd::Participant participant = dds.participant();
     sd::MapClientConfig cfg;
-    cfg.ns = dds.ns;
+    cfg.ns = dds.settings().ns;
     cfg.limits.num_classes = static_cast<std::uint16_t>(num_classes);
     sd::MapClient client(participant, cfg);
-    sd::Topic<sd::msg::Odometry> odom_topic(participant,
-                                            sd::topic_name(dds.ns, sd::SemapTopic::kOdometry));
+    sd::Topic<sd::msg::Odometry> odom_topic(
+        participant, sd::topic_name(dds.settings().ns, sd::SemapTopic::kOdometry));
     sd::Reader<sd::msg::Odometry> odom(participant, odom_topic,
                                        sd::topic_qos(sd::SemapTopic::kOdometry));
 
-    std::cout << "listening on " << sd::topic_name(dds.ns, sd::SemapTopic::kMapBlocks)
-              << " (domain " << dds.domain << ")" << std::endl;
+    std::cout << "listening on " << sd::topic_name(dds.settings().ns, sd::SemapTopic::kMapBlocks)
+              << " (domain " << dds.settings().domain << ")" << std::endl;
     const auto start = std::chrono::steady_clock::now();
     auto next_report = start;
     std::uint64_t info_seen = 0;

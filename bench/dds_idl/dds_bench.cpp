@@ -20,6 +20,7 @@
 #include "semap/dds_idl/block_codec.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
+#include "semap/dds_idl/reader.hpp"
 #include "semap/dds_idl/topic_names.hpp"
 
 namespace sd = semap::dds_idl;

@@ -1,5 +1,7 @@
 #include "semap/dds_idl/map_publisher.hpp"
 
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 #include "semap/dds_idl/block_codec.hpp"

@@ -77,7 +77,7 @@ TEST_F(SecurityTest, UnauthenticatedParticipantReceivesNothing) {
   ASSERT_TRUE(pose.expect("writer ok", seconds(10)));
   ASSERT_TRUE(map.expect("published 50", seconds(10)));
   // Control: a permitted planner in another process does receive in the same period.
-  ChildProcess planner(secured_peer("pose-listen", "planner", {"--ns", ns, "--seconds", "3"}));
+  ChildProcess planner(secured_peer("pose-listen", "planner", {"--ns", ns, "--seconds", "8"}));
 
   Participant eavesdropper(test_domain());
   Topic<msg::PoseWithCovarianceStamped> topic(eavesdropper, topic_name(ns, SemapTopic::kPose));
@@ -87,7 +87,7 @@ TEST_F(SecurityTest, UnauthenticatedParticipantReceivesNothing) {
   EXPECT_FALSE(client.wait_for_blocks(1, milliseconds(500)));
   EXPECT_EQ(client.counters().accepted + client.counters().rejected_total(), 0u);
 
-  const auto received = planner.expect("received", seconds(10));
+  const auto received = planner.expect("received", seconds(20));
   ASSERT_TRUE(received);
   EXPECT_NE(*received, "received 0");
 }
@@ -132,9 +132,9 @@ TEST_F(SecurityTest, SecuredXmlConfigurationGivesTheSameRights) {
         "SEMAP_DDS_SECURITY_DIR=" + dir_.string(), "SEMAP_DDS_IDENTITY=" + who,
         "SEMAP_DDS_SECURITY_PLUGINS=" + std::string(SEMAP_DDS_SECURITY_PLUGIN_DIR)};
   };
-  ChildProcess planner(peer("pose-listen", {"--ns", ns, "--seconds", "2"}), env("planner"));
+  ChildProcess planner(peer("pose-listen", {"--ns", ns, "--seconds", "8"}), env("planner"));
   ChildProcess intruder(peer("pose-listen", {"--ns", ns, "--seconds", "2"}), env("intruder"));
-  const auto received = planner.expect("received", seconds(10));
+  const auto received = planner.expect("received", seconds(20));
   ASSERT_TRUE(received);
   EXPECT_NE(*received, "received 0");
   EXPECT_TRUE(intruder.expect("error: dds_create_participant", seconds(10)));

@@ -9,7 +9,6 @@
 #include "semap/dds_idl/block_snapshot.hpp"
 #include "semap/dds_idl/map_cloud.hpp"
 #include "semap/dds_idl/map_description.hpp"
-#include "semap/dds_idl/reader.hpp"
 #include "semap/dds_idl/writer.hpp"
 
 namespace semap::dds_idl {

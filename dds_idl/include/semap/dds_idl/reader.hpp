@@ -30,8 +30,8 @@ class Reader {
       std::array<void*, kBatch> samples{};
       std::array<dds_sample_info_t, kBatch> infos{};
       const dds_return_t n =
-          check(dds_take(entity_.handle(), samples.data(), infos.data(), kBatch, kBatch),
-                "dds_take " + topic_name_);
+          dds_take(entity_.handle(), samples.data(), infos.data(), kBatch, kBatch);
+      if (n < 0) throw DdsError("dds_take " + topic_name_, n);
       if (n == 0) break;
       // The loan goes back even when f throws.
       struct Loan {

@@ -18,7 +18,9 @@ class Writer {
                       "dds_create_writer " + topic.name())) {}
 
   void write(const T& sample) {
-    check(dds_write(entity_.handle(), &sample), "dds_write " + topic_name_);
+    // The message is built only on failure: this is the hot path.
+    const dds_return_t rc = dds_write(entity_.handle(), &sample);
+    if (rc < 0) throw DdsError("dds_write " + topic_name_, rc);
   }
 
   // Number of currently matched readers.
