@@ -25,6 +25,8 @@ struct LogOddsParams {
   // long-observed voxel can still change its mind (the label analogue of clamping).
   double label_spread = 50.0;
   double max_range = 30.0;
+
+  bool operator==(const LogOddsParams&) const = default;
 };
 
 // Everything needed to interpret a map's evidence; stored in the .smap header.
