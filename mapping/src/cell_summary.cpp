@@ -7,7 +7,7 @@
 
 namespace semap::mapping {
 
-std::vector<double> class_probabilities(const MapParams& params, std::span<const float> fused) {
+std::vector<double> class_probabilities(const LayeredMapParams& params, std::span<const float> fused) {
   std::vector<double> p(static_cast<std::size_t>(params.num_classes));
   if (params.method == MapMethod::kLogOdds) {
     LogOddsModel::probabilities(fused.subspan(1), p);
@@ -18,7 +18,7 @@ std::vector<double> class_probabilities(const MapParams& params, std::span<const
   return p;
 }
 
-CellSummary summarize(const MapParams& params, std::span<const float> fused) {
+CellSummary summarize(const LayeredMapParams& params, std::span<const float> fused) {
   CellSummary s;
   const std::vector<double> p = class_probabilities(params, fused);
   const auto best = std::max_element(p.begin(), p.end());

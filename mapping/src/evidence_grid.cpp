@@ -5,17 +5,17 @@
 
 namespace semap::mapping {
 
-EvidenceGrid::EvidenceGrid(int block_depth, int channels)
-    : block_side_(1 << block_depth), channels_(channels) {
-  if (block_depth < 0 || block_depth > 6) {
-    throw std::invalid_argument("EvidenceGrid: block depth " + std::to_string(block_depth) +
-                                " outside 0..6");
+EvidenceGrid::EvidenceGrid(int block_side, int channels)
+    : block_side_(block_side), channels_(channels) {
+  if (block_side < 1 || block_side > 64) {
+    throw std::invalid_argument("EvidenceGrid: block side " + std::to_string(block_side) +
+                                " outside 1..64");
   }
   if (channels <= 0) throw std::invalid_argument("EvidenceGrid: channels must be positive");
 }
 
 std::span<float> EvidenceGrid::cell(const CellIndex& cell) {
-  const BlockKey key = block_of(cell, block_side_);
+  const BlockIndex key = block_of_cell(cell, block_side_);
   Block& block = blocks_[key];
   if (block.empty()) block.assign(block_floats(), 0.0f);
   const auto offset = static_cast<std::size_t>(local_index(cell, key, block_side_)) *
@@ -24,7 +24,7 @@ std::span<float> EvidenceGrid::cell(const CellIndex& cell) {
 }
 
 std::span<const float> EvidenceGrid::find(const CellIndex& cell) const {
-  const BlockKey key = block_of(cell, block_side_);
+  const BlockIndex key = block_of_cell(cell, block_side_);
   const auto it = blocks_.find(key);
   if (it == blocks_.end()) return {};
   const auto offset = static_cast<std::size_t>(local_index(cell, key, block_side_)) *
@@ -32,12 +32,12 @@ std::span<const float> EvidenceGrid::find(const CellIndex& cell) const {
   return {it->second.data() + offset, static_cast<std::size_t>(channels_)};
 }
 
-const EvidenceGrid::Block* EvidenceGrid::find_block(const BlockKey& key) const {
+const EvidenceGrid::Block* EvidenceGrid::find_block(const BlockIndex& key) const {
   const auto it = blocks_.find(key);
   return it == blocks_.end() ? nullptr : &it->second;
 }
 
-void EvidenceGrid::put_block(const BlockKey& key, Block block) {
+void EvidenceGrid::put_block(const BlockIndex& key, Block block) {
   if (block.size() != block_floats()) {
     throw std::invalid_argument("EvidenceGrid::put_block: block holds " +
                                 std::to_string(block.size()) + " floats, expected " +
@@ -46,7 +46,7 @@ void EvidenceGrid::put_block(const BlockKey& key, Block block) {
   blocks_[key] = std::move(block);
 }
 
-std::optional<EvidenceGrid::Block> EvidenceGrid::take_block(const BlockKey& key) {
+std::optional<EvidenceGrid::Block> EvidenceGrid::take_block(const BlockIndex& key) {
   const auto it = blocks_.find(key);
   if (it == blocks_.end()) return std::nullopt;
   Block block = std::move(it->second);

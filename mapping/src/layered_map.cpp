@@ -8,7 +8,7 @@
 
 namespace semap::mapping {
 
-LayeredMap::LayeredMap(const MapParams& params) : params_(params) { validate(params_); }
+LayeredMap::LayeredMap(const LayeredMapParams& params) : params_(params) { validate(params_); }
 
 EvidenceGrid& LayeredMap::layer(SourceId source) {
   auto it = layers_.find(source);
@@ -54,7 +54,7 @@ bool LayeredMap::fused(const CellIndex& cell, std::span<float> out) const {
   return known;
 }
 
-bool LayeredMap::fused_block(const BlockKey& key, std::vector<float>& out) const {
+bool LayeredMap::fused_block(const BlockIndex& key, std::vector<float>& out) const {
   const auto cells =
       static_cast<std::size_t>(params_.block_side() * params_.block_side() * params_.block_side());
   out.assign(cells * static_cast<std::size_t>(params_.channels()), 0.0f);
@@ -72,8 +72,8 @@ bool LayeredMap::fused_block(const BlockKey& key, std::vector<float>& out) const
   return any;
 }
 
-std::vector<BlockKey> LayeredMap::block_keys() const {
-  std::unordered_set<BlockKey, BlockKeyHash> keys;
+std::vector<BlockIndex> LayeredMap::block_keys() const {
+  std::unordered_set<BlockIndex, BlockIndexHash> keys;
   for (const auto& [source, grid] : layers_) {
     for (const auto& [key, block] : grid.blocks()) keys.insert(key);
   }

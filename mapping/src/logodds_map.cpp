@@ -12,7 +12,7 @@ namespace {
 
 struct CellHash {
   std::size_t operator()(const CellIndex& c) const {
-    return BlockKeyHash{}(BlockKey{c.x(), c.y(), c.z()});
+    return BlockIndexHash{}(BlockIndex{c.x(), c.y(), c.z()});
   }
 };
 
@@ -20,7 +20,7 @@ using CellSet = std::unordered_set<CellIndex, CellHash>;
 
 }  // namespace
 
-LogOddsMap::LogOddsMap(const MapParams& params, SourceId robot)
+LogOddsMap::LogOddsMap(const LayeredMapParams& params, SourceId robot)
     : LogOddsMap(LayeredMap(params), robot) {}
 
 LogOddsMap::LogOddsMap(LayeredMap map, SourceId robot)
@@ -32,7 +32,7 @@ LogOddsMap::LogOddsMap(LayeredMap map, SourceId robot)
 }
 
 void LogOddsMap::insert(const common::LabeledCloud& cloud) {
-  const MapParams& p = map_.params();
+  const LayeredMapParams& p = map_.params();
   const auto k = static_cast<std::size_t>(p.num_classes);
   if (cloud.has_probabilities() ? cloud.probabilities.size() != cloud.size() * k
                                 : cloud.labels.size() != cloud.size()) {

@@ -113,7 +113,7 @@ constexpr std::array<NamedParameter, 7> kLogOddsParameters = {{
 }};
 
 void encode_header(Writer& w, const LayeredMap& map) {
-  const MapParams& p = map.params();
+  const LayeredMapParams& p = map.params();
   w.put_bytes(kMagic.data(), kMagic.size());
   w.put(kSmapVersion);
   w.put(static_cast<std::uint8_t>(p.method));
@@ -134,7 +134,7 @@ void encode_header(Writer& w, const LayeredMap& map) {
 }
 
 struct Header {
-  MapParams params;
+  LayeredMapParams params;
   std::uint32_t layers = 0;
   std::size_t unknown_parameters = 0;
 };
@@ -190,11 +190,11 @@ Header decode_header(Reader& r) {
   return h;
 }
 
-std::vector<BlockKey> sorted_keys(const EvidenceGrid& grid) {
-  std::vector<BlockKey> keys;
+std::vector<BlockIndex> sorted_keys(const EvidenceGrid& grid) {
+  std::vector<BlockIndex> keys;
   keys.reserve(grid.size());
   for (const auto& [key, block] : grid.blocks()) keys.push_back(key);
-  std::sort(keys.begin(), keys.end(), [](const BlockKey& a, const BlockKey& b) {
+  std::sort(keys.begin(), keys.end(), [](const BlockIndex& a, const BlockIndex& b) {
     return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
   });
   return keys;
@@ -213,7 +213,7 @@ std::vector<std::uint8_t> encode_smap(const LayeredMap& map) {
     w.put(grid.updates());
     w.put(static_cast<std::uint32_t>(grid.size()));
     w.put_crc_since(start);
-    for (const BlockKey& key : sorted_keys(grid)) {
+    for (const BlockIndex& key : sorted_keys(grid)) {
       const auto& block = *grid.find_block(key);
       const std::size_t block_start = w.size();
       w.put(kBlockTag);
@@ -267,7 +267,7 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
         if (r.get<std::uint32_t>("block tag") != kBlockTag) {
           r.fail_at(block_start, block_where + ": bad tag");
         }
-        const BlockKey key{r.get<std::int32_t>("block x"), r.get<std::int32_t>("block y"),
+        const BlockIndex key{r.get<std::int32_t>("block x"), r.get<std::int32_t>("block y"),
                            r.get<std::int32_t>("block z")};
         const auto count = r.get<std::uint32_t>("block value count");
         if (count != block_floats) {

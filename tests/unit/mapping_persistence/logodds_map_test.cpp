@@ -9,8 +9,8 @@
 namespace semap::mapping {
 namespace {
 
-MapParams logodds_params(int classes = 5) {
-  MapParams p;
+LayeredMapParams logodds_params(int classes = 5) {
+  LayeredMapParams p;
   p.method = MapMethod::kLogOdds;
   p.resolution = 0.1;
   p.num_classes = classes;
@@ -107,7 +107,7 @@ TEST(LogOddsMap, CellHitAndCrossedInOneScanCountsAsHit) {
 }
 
 TEST(LogOddsMap, BeamsBeyondMaxRangeOnlyClearSpace) {
-  MapParams p = logodds_params();
+  LayeredMapParams p = logodds_params();
   p.logodds.max_range = 0.5;
   LogOddsMap map(p, 1);
   map.insert(beam({0.05f, 0.05f, 0.05f}, {2.05f, 0.05f, 0.05f}, 1));
@@ -121,7 +121,7 @@ TEST(LogOddsMap, RejectsCloudWithMismatchedLabels) {
   common::LabeledCloud cloud;
   cloud.points = {{1.0f, 0.0f, 0.0f}};
   EXPECT_THROW(map.insert(cloud), std::invalid_argument);
-  MapParams bki = logodds_params();
+  LayeredMapParams bki = logodds_params();
   bki.method = MapMethod::kBki;
   EXPECT_THROW(LogOddsMap(bki, 1), std::invalid_argument);
 }

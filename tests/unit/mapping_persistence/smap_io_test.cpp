@@ -38,7 +38,7 @@ TEST_F(SmapIo, RoundTripKeepsEveryLayerAndParameter) {
 }
 
 TEST_F(SmapIo, RoundTripOfDirichletMap) {
-  MapParams p;
+  LayeredMapParams p;
   p.method = MapMethod::kBki;
   p.num_classes = 3;
   p.prior = 0.01;

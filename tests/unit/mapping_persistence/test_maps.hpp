@@ -7,11 +7,11 @@
 
 namespace semap::mapping::testing {
 
-inline MapParams small_logodds_params() {
-  MapParams p;
+inline LayeredMapParams small_logodds_params() {
+  LayeredMapParams p;
   p.method = MapMethod::kLogOdds;
   p.resolution = 0.1;
-  p.block_depth = 2;
+  p.block_depth = 3;
   p.num_classes = 4;
   return p;
 }

@@ -16,9 +16,9 @@ namespace semap::mapping {
 class EvidenceGrid {
  public:
   using Block = std::vector<float>;
-  using BlockMap = std::unordered_map<BlockKey, Block, BlockKeyHash>;
+  using BlockMap = std::unordered_map<BlockIndex, Block, BlockIndexHash>;
 
-  EvidenceGrid(int block_depth, int channels);
+  EvidenceGrid(int block_side, int channels);
 
   int block_side() const { return block_side_; }
   int cells_per_block() const { return block_side_ * block_side_ * block_side_; }
@@ -33,11 +33,11 @@ class EvidenceGrid {
   std::span<const float> find(const CellIndex& cell) const;
 
   const BlockMap& blocks() const { return blocks_; }
-  const Block* find_block(const BlockKey& key) const;
+  const Block* find_block(const BlockIndex& key) const;
   // Replaces the block at `key`; `block` must hold block_floats() values.
-  void put_block(const BlockKey& key, Block block);
+  void put_block(const BlockIndex& key, Block block);
   // Removes and returns the block at `key`, if any.
-  std::optional<Block> take_block(const BlockKey& key);
+  std::optional<Block> take_block(const BlockIndex& key);
   std::size_t size() const { return blocks_.size(); }
 
   // Number of scans integrated into this grid; orders two copies of one robot's evidence

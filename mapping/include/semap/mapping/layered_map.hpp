@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "semap/mapping/evidence_grid.hpp"
-#include "semap/mapping/map_params.hpp"
+#include "semap/mapping/layered_map_params.hpp"
 
 namespace semap::mapping {
 
@@ -22,9 +22,9 @@ using SourceId = std::uint32_t;
 //   S-BKI/S-CSM: alpha = alpha_0 + sum_s (alpha_s - alpha_0), the layers holding increments.
 class LayeredMap {
  public:
-  explicit LayeredMap(const MapParams& params);
+  explicit LayeredMap(const LayeredMapParams& params);
 
-  const MapParams& params() const { return params_; }
+  const LayeredMapParams& params() const { return params_; }
 
   // The layer of `source`, created empty on first use.
   EvidenceGrid& layer(SourceId source);
@@ -38,13 +38,13 @@ class LayeredMap {
   // leaves the prior in `out`) when no layer has evidence there.
   bool fused(const CellIndex& cell, std::span<float> out) const;
   // Fused channels of a whole block (cells_per_block x channels); false if no layer has it.
-  bool fused_block(const BlockKey& key, std::vector<float>& out) const;
+  bool fused_block(const BlockIndex& key, std::vector<float>& out) const;
   // Union of the block keys of all layers.
-  std::vector<BlockKey> block_keys() const;
+  std::vector<BlockIndex> block_keys() const;
   // Blocks over all layers (what a memory budget counts).
   std::size_t resident_blocks() const;
 
-  EvidenceGrid make_grid() const { return EvidenceGrid(params_.block_depth, params_.channels()); }
+  EvidenceGrid make_grid() const { return EvidenceGrid(params_.block_side(), params_.channels()); }
 
   bool operator==(const LayeredMap& other) const = default;
 
@@ -52,7 +52,7 @@ class LayeredMap {
   void fuse_into(std::span<const float> layer, std::span<float> out) const;
   void finish_fusion(std::span<float> out) const;
 
-  MapParams params_;
+  LayeredMapParams params_;
   std::map<SourceId, EvidenceGrid> layers_;
 };
 

@@ -18,7 +18,7 @@ namespace semap::mapping {
 class LogOddsMap {
  public:
   // `params.method` must be kLogOdds; `robot` names the layer this map's own scans go to.
-  LogOddsMap(const MapParams& params, SourceId robot);
+  LogOddsMap(const LayeredMapParams& params, SourceId robot);
   // Continues a map loaded from disk or received from elsewhere.
   LogOddsMap(LayeredMap map, SourceId robot);
 
@@ -32,7 +32,7 @@ class LogOddsMap {
   std::vector<double> class_probabilities(const CellIndex& cell) const;
   double occupancy_probability(const CellIndex& cell) const;
 
-  const MapParams& params() const { return map_.params(); }
+  const LayeredMapParams& params() const { return map_.params(); }
   SourceId robot() const { return robot_; }
   const LayeredMap& layers() const { return map_; }
   LayeredMap& layers() { return map_; }

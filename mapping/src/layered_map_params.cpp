@@ -1,4 +1,4 @@
-#include "semap/mapping/map_params.hpp"
+#include "semap/mapping/layered_map_params.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -17,7 +17,7 @@ std::string to_string(MapMethod method) {
   return "unknown";
 }
 
-MapMethod method_from_string(const std::string& name) {
+MapMethod map_method_from_string(const std::string& name) {
   if (name == "bki") return MapMethod::kBki;
   if (name == "csm") return MapMethod::kCsm;
   if (name == "logodds") return MapMethod::kLogOdds;
@@ -34,10 +34,10 @@ bool probability(double p) { return std::isfinite(p) && p > 0.0 && p < 1.0; }
 
 }  // namespace
 
-void validate(const MapParams& params) {
+void validate(const LayeredMapParams& params) {
   require(std::isfinite(params.resolution) && params.resolution > 1e-4 && params.resolution < 1e3,
           "resolution must lie in (1e-4, 1e3) m");
-  require(params.block_depth >= 0 && params.block_depth <= 6, "block_depth must lie in 0..6");
+  require(params.block_depth >= 1 && params.block_depth <= 7, "block_depth must lie in 1..7");
   require(params.num_classes >= 1 && params.num_classes <= 1024, "num_classes must lie in 1..1024");
   require(std::isfinite(params.prior) && params.prior > 0.0, "prior must be positive");
   const LogOddsParams& lo = params.logodds;

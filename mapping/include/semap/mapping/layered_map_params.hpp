@@ -10,7 +10,7 @@ enum class MapMethod : std::uint8_t { kBki = 0, kCsm = 1, kLogOdds = 2 };
 
 std::string to_string(MapMethod method);
 // Parses "bki", "csm" or "logodds"; throws std::invalid_argument otherwise.
-MapMethod method_from_string(const std::string& name);
+MapMethod map_method_from_string(const std::string& name);
 
 // Occupancy and label model of the log-odds map (Yue et al.), OctoMap's occupancy defaults.
 struct LogOddsParams {
@@ -30,7 +30,7 @@ struct LogOddsParams {
 };
 
 // Everything needed to interpret a map's evidence; stored in the .smap header.
-struct MapParams {
+struct LayeredMapParams {
   MapMethod method = MapMethod::kLogOdds;
   double resolution = 0.1;
   int block_depth = 3;
@@ -42,13 +42,14 @@ struct MapParams {
   // Floats per cell: log-odds maps store occupancy then K label log-odds, S-BKI/S-CSM maps
   // store K Dirichlet evidence increments.
   int channels() const { return method == MapMethod::kLogOdds ? num_classes + 1 : num_classes; }
-  int block_side() const { return 1 << block_depth; }
+  // Same convention as SemanticMap: a block of depth d has 2^(d-1) cells per side.
+  int block_side() const { return 1 << (block_depth - 1); }
   double block_size() const { return resolution * block_side(); }
 
-  bool operator==(const MapParams&) const = default;
+  bool operator==(const LayeredMapParams&) const = default;
 };
 
 // Throws std::invalid_argument naming the first parameter that is out of range.
-void validate(const MapParams& params);
+void validate(const LayeredMapParams& params);
 
 }  // namespace semap::mapping
