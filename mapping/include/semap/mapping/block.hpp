@@ -1,0 +1,50 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+namespace semap::mapping {
+
+// A dense cube of cells_per_side^3 cells. Per cell it stores K floats of Dirichlet evidence
+// (alpha minus the prior, so blocks from different maps can simply be added) and one bit
+// that says whether the cell ever received evidence. Cell c = (z * n + y) * n + x holds
+// evidence()[c * K .. c * K + K).
+class Block {
+ public:
+  Block(int cells_per_side, int num_classes);
+
+  int cells_per_side() const { return n_; }
+  int num_cells() const { return n_ * n_ * n_; }
+  int num_classes() const { return k_; }
+  int cell_of(int x, int y, int z) const { return (z * n_ + y) * n_ + x; }
+
+  std::span<const float> evidence() const;
+  std::span<const float> cell_evidence(int cell) const {
+    return {evidence_.get() + static_cast<std::size_t>(cell) * k_, static_cast<std::size_t>(k_)};
+  }
+  // Raw write access for the map's scatter loop; callers mark the cells they touch.
+  float* cell_evidence_mutable(int cell) {
+    return evidence_.get() + static_cast<std::size_t>(cell) * k_;
+  }
+
+  bool observed(int cell) const { return (observed_[cell >> 6] >> (cell & 63)) & 1u; }
+  void mark_observed(int cell) { observed_[cell >> 6] |= std::uint64_t{1} << (cell & 63); }
+  int num_observed() const;
+
+  // Adds evidence for every cell (num_cells * K floats); cells whose added evidence sums to
+  // more than zero become observed. This is how maps are merged.
+  void add_evidence(std::span<const float> evidence);
+
+  // Heap bytes owned by this block (evidence, observed bits and the object itself).
+  std::size_t bytes() const;
+
+ private:
+  int n_;
+  int k_;
+  std::unique_ptr<float[]> evidence_;
+  std::unique_ptr<std::uint64_t[]> observed_;
+};
+
+}  // namespace semap::mapping

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <string>
+
+#include "semap/common/config.hpp"
+
+namespace semap::mapping {
+
+// S-CSM counts points per cell; S-BKI spreads each point over the cells within the sparse
+// kernel's support. Both share storage and the insertion path.
+enum class Method { kBki, kCsm };
+
+Method method_from_string(const std::string& name);  // "bki" | "csm"
+std::string to_string(Method method);
+
+// Parameters of a semantic map, named as in the paper's reference configuration.
+struct MapParams {
+  Method method = Method::kBki;
+  float resolution = 0.1f;  // cell edge, m
+  int block_depth = 3;      // a block holds (2^(depth-1))^3 cells
+  int num_classes = 4;      // K, class 0 is free space
+  float sf2 = 10.0f;        // kernel scale sigma_0
+  float ell = 0.3f;         // kernel support radius, m
+  float prior = 0.001f;     // Dirichlet prior alpha_0 for every class
+  float free_res = 0.5f;    // spacing of free-space samples along a beam, m
+  float ds_res = 0.1f;      // voxel size of the training-data downsampling, m
+  float max_range = 8.0f;   // hits farther from the origin are dropped; <= 0 keeps all
+  // When > 0, a cell whose argmax-class variance exceeds this is reported unknown.
+  float unknown_variance = 0.0f;
+
+  int cells_per_side() const { return 1 << (block_depth - 1); }
+  int cells_per_block() const { return cells_per_side() * cells_per_side() * cells_per_side(); }
+  float block_size() const { return resolution * static_cast<float>(cells_per_side()); }
+
+  // Throws std::invalid_argument naming the first bad field.
+  void validate() const;
+};
+
+// Reads a `map:`-shaped section (method, resolution, block_depth, num_classes, sf2, ell,
+// prior, free_res, ds_res, max_range, unknown_variance); absent keys keep `defaults`.
+// Does not call finish(), so callers may read further keys from the same section.
+MapParams map_params_from_config(const common::ConfigSection& section,
+                                 const MapParams& defaults = MapParams{});
+
+}  // namespace semap::mapping

@@ -1,0 +1,98 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <span>
+#include <unordered_map>
+
+#include "semap/common/messages.hpp"
+#include "semap/mapping/block.hpp"
+#include "semap/mapping/block_index.hpp"
+#include "semap/mapping/cell_posterior.hpp"
+#include "semap/mapping/kernel.hpp"
+#include "semap/mapping/map_params.hpp"
+#include "semap/mapping/training_data.hpp"
+
+namespace semap::mapping {
+
+struct MapStats {
+  std::size_t blocks = 0;
+  std::size_t cells = 0;           // allocated cells (blocks * cells per block)
+  std::size_t observed_cells = 0;  // cells that received evidence
+  std::size_t bytes = 0;           // blocks plus the block table
+  std::size_t scans = 0;
+  std::size_t rejected_points = 0;  // bad input points, summed over scans
+  double bytes_per_cell() const { return cells ? static_cast<double>(bytes) / cells : 0.0; }
+};
+
+// What one insert did.
+struct InsertResult {
+  std::size_t training_points = 0;
+  std::size_t hits = 0;
+  std::size_t rejected_points = 0;
+  std::size_t out_of_range = 0;
+  std::size_t blocks_updated = 0;
+};
+
+// The continuous semantic map of Gan et al. (S-CSM / S-BKI): a hash map of blocks of cells,
+// each cell a Dirichlet posterior over K classes updated in place by every scan.
+//
+// Insertion runs in parallel over blocks with TBB (use a tbb::task_arena or
+// tbb::global_control to bound threads). Every block is written by one task that visits its
+// training points in a fixed order, so the result does not depend on the thread count.
+class SemanticMap {
+ public:
+  explicit SemanticMap(const MapParams& params);
+
+  const MapParams& params() const { return params_; }
+
+  // Builds the scan's training set (see build_training_set) and fuses it.
+  InsertResult insert(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin);
+  // Fuses a prepared training set: each point adds k(d) y to every cell centre within ell
+  // (S-BKI) or y to the cell containing it (S-CSM).
+  InsertResult insert(const TrainingSet& training);
+
+  // The cell containing `point`; nullopt outside allocated blocks.
+  std::optional<CellPosterior> query(const Eigen::Vector3f& point) const;
+  // Class at `point`: the argmax, or -1 where the map is unknown.
+  int label_at(const Eigen::Vector3f& point) const;
+
+  // Calls f(const BlockIndex&, const Block&) for every block, in no particular order.
+  template <typename F>
+  void for_each_block(F&& f) const {
+    for (const auto& [index, block] : blocks_) f(index, block);
+  }
+  // Calls f(const Eigen::Vector3f& centre, const CellPosterior&) for every observed cell.
+  template <typename F>
+  void for_each_cell(F&& f) const {
+    for (const auto& [index, block] : blocks_) {
+      for (int c = 0; c < block.num_cells(); ++c) {
+        if (!block.observed(c)) continue;
+        f(cell_center(index, c), CellPosterior(block.cell_evidence(c), params_.prior, true));
+      }
+    }
+  }
+
+  const Block* find_block(const BlockIndex& index) const;
+  // Adds evidence (cells per block * K floats) to a block, creating it if needed (merging).
+  void add_evidence(const BlockIndex& index, std::span<const float> evidence);
+
+  BlockIndex block_of(const Eigen::Vector3f& point) const;
+  Eigen::Vector3f cell_center(const BlockIndex& block, int cell) const;
+
+  MapStats stats() const;
+
+ private:
+  Block& block_at(const BlockIndex& index);
+
+  MapParams params_;
+  KernelTable kernel_;
+  // Node-based, so Block references stay valid while other blocks are added.
+  std::unordered_map<BlockIndex, Block, BlockIndexHash> blocks_;
+  std::size_t scans_ = 0;
+  std::size_t rejected_ = 0;
+};
+
+}  // namespace semap::mapping

@@ -1,0 +1,53 @@
+#include "semap/mapping/block.hpp"
+
+#include <bit>
+#include <stdexcept>
+#include <string>
+
+namespace semap::mapping {
+
+namespace {
+
+std::size_t words_for(int cells) { return (static_cast<std::size_t>(cells) + 63) / 64; }
+
+}  // namespace
+
+Block::Block(int cells_per_side, int num_classes)
+    : n_(cells_per_side),
+      k_(num_classes),
+      evidence_(new float[static_cast<std::size_t>(num_cells()) * num_classes]()),
+      observed_(new std::uint64_t[words_for(num_cells())]()) {}
+
+std::span<const float> Block::evidence() const {
+  return {evidence_.get(), static_cast<std::size_t>(num_cells()) * k_};
+}
+
+int Block::num_observed() const {
+  int count = 0;
+  for (std::size_t w = 0; w < words_for(num_cells()); ++w) count += std::popcount(observed_[w]);
+  return count;
+}
+
+void Block::add_evidence(std::span<const float> evidence) {
+  if (evidence.size() != static_cast<std::size_t>(num_cells()) * k_) {
+    throw std::invalid_argument("block evidence has " + std::to_string(evidence.size()) +
+                                " floats, expected " + std::to_string(num_cells() * k_));
+  }
+  for (int c = 0; c < num_cells(); ++c) {
+    float* dst = cell_evidence_mutable(c);
+    const float* src = evidence.data() + static_cast<std::size_t>(c) * k_;
+    float sum = 0.0f;
+    for (int k = 0; k < k_; ++k) {
+      dst[k] += src[k];
+      sum += src[k];
+    }
+    if (sum > 0.0f) mark_observed(c);
+  }
+}
+
+std::size_t Block::bytes() const {
+  return sizeof(Block) + static_cast<std::size_t>(num_cells()) * k_ * sizeof(float) +
+         words_for(num_cells()) * sizeof(std::uint64_t);
+}
+
+}  // namespace semap::mapping

@@ -1,0 +1,269 @@
+#include "semap/mapping/semantic_map.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "semap/mapping/voxel_hash_map.hpp"
+
+namespace semap::mapping {
+
+namespace {
+
+// Inclusive range of global cell coordinates per axis.
+struct CellBox {
+  std::array<std::int32_t, 3> lo;
+  std::array<std::int32_t, 3> hi;
+};
+
+// Malloc bookkeeping per heap allocation, counted so bytes per cell is not flattering.
+constexpr std::size_t kAllocOverhead = 16;
+
+// Training points are dropped when their cell coordinates could overflow the block keys.
+bool mappable(const Eigen::Vector3f& p, float inv_res) {
+  constexpr float kLimit = static_cast<float>(1 << 20) - 64.0f;
+  return p.allFinite() && (p.cwiseAbs() * inv_res).maxCoeff() < kLimit;
+}
+
+// Cells a training point touches: for S-BKI all cells whose centre lies within ell per
+// axis (the sphere test follows per cell), for S-CSM the cell containing the point.
+CellBox support_of(const Eigen::Vector3f& p, const MapParams& params) {
+  const float inv_res = 1.0f / params.resolution;
+  CellBox box{};
+  for (int a = 0; a < 3; ++a) {
+    if (params.method == Method::kCsm) {
+      box.lo[a] = box.hi[a] = static_cast<std::int32_t>(std::floor(p[a] * inv_res));
+    } else {
+      box.lo[a] = static_cast<std::int32_t>(std::ceil((p[a] - params.ell) * inv_res - 0.5f));
+      box.hi[a] = static_cast<std::int32_t>(std::floor((p[a] + params.ell) * inv_res - 0.5f));
+    }
+  }
+  return box;
+}
+
+// Training point indices grouped by the blocks their support overlaps; points of a block
+// are in ascending order, which fixes the summation order of every cell.
+struct BlockGroups {
+  std::vector<BlockIndex> blocks;
+  std::vector<std::uint32_t> offsets;  // blocks.size() + 1
+  std::vector<std::uint32_t> points;
+};
+
+BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::uint8_t>& usable,
+                           const MapParams& params) {
+  const std::int32_t n = params.cells_per_side();
+  VoxelHashMap ids(training.size() / 4 + 16);
+  BlockGroups groups;
+  std::vector<std::uint32_t> counts;
+  // (block id, point index) pairs in point order.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  pairs.reserve(training.size() * 2);
+  for (std::size_t i = 0; i < training.size(); ++i) {
+    if (!usable[i]) continue;
+    const CellBox box = support_of(training.points[i], params);
+    if (box.lo[0] > box.hi[0] || box.lo[1] > box.hi[1] || box.lo[2] > box.hi[2]) continue;
+    for (std::int32_t bz = floor_div(box.lo[2], n); bz <= floor_div(box.hi[2], n); ++bz) {
+      for (std::int32_t by = floor_div(box.lo[1], n); by <= floor_div(box.hi[1], n); ++by) {
+        for (std::int32_t bx = floor_div(box.lo[0], n); bx <= floor_div(box.hi[0], n); ++bx) {
+          const BlockIndex b{bx, by, bz};
+          const std::uint32_t id = ids.insert(b);
+          if (id == groups.blocks.size()) {
+            groups.blocks.push_back(b);
+            counts.push_back(0);
+          }
+          ++counts[id];
+          pairs.emplace_back(id, static_cast<std::uint32_t>(i));
+        }
+      }
+    }
+  }
+  groups.offsets.assign(groups.blocks.size() + 1, 0);
+  for (std::size_t b = 0; b < counts.size(); ++b) {
+    groups.offsets[b + 1] = groups.offsets[b] + counts[b];
+  }
+  std::vector<std::uint32_t> fill(groups.offsets.begin(), groups.offsets.end() - 1);
+  groups.points.resize(pairs.size());
+  for (const auto& [id, i] : pairs) groups.points[fill[id]++] = i;
+  return groups;
+}
+
+// Adds weight * y_i to one cell.
+inline void accumulate(Block& block, int cell, float weight, const TrainingSet& training,
+                       std::size_t i) {
+  float* alpha = block.cell_evidence_mutable(cell);
+  const std::int32_t label = training.labels[i];
+  if (label >= 0) {
+    alpha[label] += weight;
+  } else {
+    const float* y = training.probabilities.data() + i * training.num_classes;
+    for (int k = 0; k < training.num_classes; ++k) alpha[k] += weight * y[k];
+  }
+  block.mark_observed(cell);
+}
+
+void update_block(Block& block, const BlockIndex& index, std::span<const std::uint32_t> points,
+                  const TrainingSet& training, const MapParams& params, const KernelTable& kernel) {
+  const std::int32_t n = params.cells_per_side();
+  const std::array<std::int32_t, 3> base{index.x * n, index.y * n, index.z * n};
+  const float res = params.resolution;
+  const float ell2 = kernel.ell_squared();
+  for (const std::uint32_t i : points) {
+    const Eigen::Vector3f& p = training.points[i];
+    CellBox box = support_of(p, params);
+    for (int a = 0; a < 3; ++a) {
+      box.lo[a] = std::max(box.lo[a], base[a]) - base[a];
+      box.hi[a] = std::min(box.hi[a], base[a] + n - 1) - base[a];
+    }
+    if (params.method == Method::kCsm) {
+      accumulate(block, block.cell_of(box.lo[0], box.lo[1], box.lo[2]), 1.0f, training, i);
+      continue;
+    }
+    for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
+      const float dz = (static_cast<float>(base[2] + z) + 0.5f) * res - p.z();
+      for (std::int32_t y = box.lo[1]; y <= box.hi[1]; ++y) {
+        const float dy = (static_cast<float>(base[1] + y) + 0.5f) * res - p.y();
+        const float dyz2 = dz * dz + dy * dy;
+        if (dyz2 >= ell2) continue;
+        for (std::int32_t x = box.lo[0]; x <= box.hi[0]; ++x) {
+          const float dx = (static_cast<float>(base[0] + x) + 0.5f) * res - p.x();
+          const float w = kernel(dyz2 + dx * dx);
+          if (w > 0.0f) accumulate(block, block.cell_of(x, y, z), w, training, i);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+SemanticMap::SemanticMap(const MapParams& params)
+    : params_(params), kernel_((params.validate(), SparseKernel(params.sf2, params.ell))) {}
+
+InsertResult SemanticMap::insert(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin) {
+  const TrainingSet training = build_training_set(cloud, origin, params_);
+  InsertResult result = insert(training);
+  result.rejected_points += training.rejected;
+  result.out_of_range = training.out_of_range;
+  rejected_ += training.rejected;
+  return result;
+}
+
+InsertResult SemanticMap::insert(const TrainingSet& training) {
+  if (training.num_classes != params_.num_classes) {
+    throw std::invalid_argument("training set has " + std::to_string(training.num_classes) +
+                                " classes, map has " + std::to_string(params_.num_classes));
+  }
+  InsertResult result;
+  result.training_points = training.size();
+  result.hits = training.num_hits;
+  const float inv_res = 1.0f / params_.resolution;
+  std::vector<std::uint8_t> usable(training.size(), 1);
+  const std::size_t soft_rows = training.probabilities.size() / params_.num_classes;
+  for (std::size_t i = 0; i < training.size(); ++i) {
+    const std::int32_t label = training.labels[i];
+    const bool label_ok = label >= 0 ? label < params_.num_classes : i < soft_rows;
+    if (!label_ok || !mappable(training.points[i], inv_res)) {
+      usable[i] = 0;
+      ++result.rejected_points;
+    }
+  }
+  rejected_ += result.rejected_points;
+
+  const BlockGroups groups = group_by_block(training, usable, params_);
+  // Creating blocks mutates the table, so it happens before the parallel part.
+  std::vector<Block*> targets(groups.blocks.size());
+  for (std::size_t b = 0; b < groups.blocks.size(); ++b) targets[b] = &block_at(groups.blocks[b]);
+
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, groups.blocks.size()),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+          const std::span<const std::uint32_t> points(groups.points.data() + groups.offsets[b],
+                                                      groups.offsets[b + 1] - groups.offsets[b]);
+          update_block(*targets[b], groups.blocks[b], points, training, params_, kernel_);
+        }
+      });
+  result.blocks_updated = groups.blocks.size();
+  ++scans_;
+  return result;
+}
+
+BlockIndex SemanticMap::block_of(const Eigen::Vector3f& point) const {
+  const float inv = 1.0f / params_.block_size();
+  return {static_cast<std::int32_t>(std::floor(point.x() * inv)),
+          static_cast<std::int32_t>(std::floor(point.y() * inv)),
+          static_cast<std::int32_t>(std::floor(point.z() * inv))};
+}
+
+Eigen::Vector3f SemanticMap::cell_center(const BlockIndex& block, int cell) const {
+  const int n = params_.cells_per_side();
+  const Eigen::Vector3f local(static_cast<float>(cell % n), static_cast<float>((cell / n) % n),
+                              static_cast<float>(cell / (n * n)));
+  const Eigen::Vector3f first(static_cast<float>(block.x * n), static_cast<float>(block.y * n),
+                              static_cast<float>(block.z * n));
+  return (first + local + Eigen::Vector3f::Constant(0.5f)) * params_.resolution;
+}
+
+std::optional<CellPosterior> SemanticMap::query(const Eigen::Vector3f& point) const {
+  const float inv_res = 1.0f / params_.resolution;
+  if (!mappable(point, inv_res)) return std::nullopt;
+  const std::int32_t n = params_.cells_per_side();
+  const std::array<std::int32_t, 3> cell{
+      static_cast<std::int32_t>(std::floor(point.x() * inv_res)),
+      static_cast<std::int32_t>(std::floor(point.y() * inv_res)),
+      static_cast<std::int32_t>(std::floor(point.z() * inv_res))};
+  const BlockIndex index{floor_div(cell[0], n), floor_div(cell[1], n), floor_div(cell[2], n)};
+  const Block* block = find_block(index);
+  if (block == nullptr) return std::nullopt;
+  const int c = block->cell_of(cell[0] - index.x * n, cell[1] - index.y * n, cell[2] - index.z * n);
+  return CellPosterior(block->cell_evidence(c), params_.prior, block->observed(c));
+}
+
+int SemanticMap::label_at(const Eigen::Vector3f& point) const {
+  const auto cell = query(point);
+  return cell ? cell->label(params_.unknown_variance) : -1;
+}
+
+const Block* SemanticMap::find_block(const BlockIndex& index) const {
+  const auto it = blocks_.find(index);
+  return it == blocks_.end() ? nullptr : &it->second;
+}
+
+Block& SemanticMap::block_at(const BlockIndex& index) {
+  auto it = blocks_.find(index);
+  if (it == blocks_.end()) {
+    it = blocks_
+             .emplace(std::piecewise_construct, std::forward_as_tuple(index),
+                      std::forward_as_tuple(params_.cells_per_side(), params_.num_classes))
+             .first;
+  }
+  return it->second;
+}
+
+void SemanticMap::add_evidence(const BlockIndex& index, std::span<const float> evidence) {
+  block_at(index).add_evidence(evidence);
+}
+
+MapStats SemanticMap::stats() const {
+  MapStats s;
+  s.blocks = blocks_.size();
+  s.scans = scans_;
+  s.rejected_points = rejected_;
+  // Hash node: next pointer, key, block object, cached hash; plus the bucket array.
+  constexpr std::size_t kNodeBytes =
+      sizeof(void*) + sizeof(std::pair<const BlockIndex, Block>) + sizeof(std::size_t);
+  s.bytes = blocks_.bucket_count() * sizeof(void*);
+  for (const auto& [index, block] : blocks_) {
+    s.cells += static_cast<std::size_t>(block.num_cells());
+    s.observed_cells += static_cast<std::size_t>(block.num_observed());
+    // The node and the block's two arrays are three heap allocations.
+    s.bytes += kNodeBytes + block.bytes() - sizeof(Block) + 3 * kAllocOverhead;
+  }
+  return s;
+}
+
+}  // namespace semap::mapping
