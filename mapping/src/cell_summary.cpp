@@ -7,7 +7,8 @@
 
 namespace semap::mapping {
 
-std::vector<double> class_probabilities(const LayeredMapParams& params, std::span<const float> fused) {
+std::vector<double> class_probabilities(const LayeredMapParams& params,
+                                        std::span<const float> fused) {
   std::vector<double> p(static_cast<std::size_t>(params.num_classes));
   if (params.method == MapMethod::kLogOdds) {
     LogOddsModel::probabilities(fused.subspan(1), p);

@@ -122,13 +122,14 @@ void encode_header(Writer& w, const LayeredMap& map) {
   w.put(static_cast<std::uint32_t>(p.channels()));
   w.put(p.resolution);
   w.put(p.prior);
-  w.put(static_cast<std::uint32_t>(kLogOddsParameters.size()));
-  for (const auto& param : kLogOddsParameters) {
-    const std::string_view name(param.name);
+  w.put(static_cast<std::uint32_t>(kLogOddsParameters.size() + p.extra.size()));
+  const auto put_named = [&](std::string_view name, double value) {
     w.put(static_cast<std::uint16_t>(name.size()));
     w.put_bytes(name.data(), name.size());
-    w.put(p.logodds.*param.field);
-  }
+    w.put(value);
+  };
+  for (const auto& param : kLogOddsParameters) put_named(param.name, p.logodds.*param.field);
+  for (const auto& [name, value] : p.extra) put_named(name, value);
   w.put(static_cast<std::uint32_t>(map.layers().size()));
   w.put_crc_since(0);
 }
@@ -136,7 +137,6 @@ void encode_header(Writer& w, const LayeredMap& map) {
 struct Header {
   LayeredMapParams params;
   std::uint32_t layers = 0;
-  std::size_t unknown_parameters = 0;
 };
 
 Header decode_header(Reader& r) {
@@ -167,10 +167,11 @@ Header decode_header(Reader& r) {
     const auto name_bytes = r.take(length, "parameter name");
     const std::string name(name_bytes.begin(), name_bytes.end());
     const auto value = r.get<double>("parameter value");
+    if (!std::isfinite(value)) r.fail("parameter " + name + " is not finite");
     const auto known = std::find_if(kLogOddsParameters.begin(), kLogOddsParameters.end(),
                                     [&](const NamedParameter& p) { return name == p.name; });
     if (known == kLogOddsParameters.end()) {
-      ++h.unknown_parameters;
+      if (!h.params.extra.emplace(name, value).second) r.fail("parameter " + name + " twice");
     } else {
       h.params.logodds.*known->field = value;
     }
@@ -237,7 +238,6 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
   Reader r(bytes, name);
   const Header header = decode_header(r);
   SmapReadResult result(LayeredMap(header.params));
-  result.unknown_parameters = header.unknown_parameters;
   const EvidenceGrid probe = result.map.make_grid();
   const std::size_t block_floats = probe.block_floats();
   // Smallest possible block record; bounds counts before anything is allocated.
@@ -268,7 +268,7 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
           r.fail_at(block_start, block_where + ": bad tag");
         }
         const BlockIndex key{r.get<std::int32_t>("block x"), r.get<std::int32_t>("block y"),
-                           r.get<std::int32_t>("block z")};
+                             r.get<std::int32_t>("block z")};
         const auto count = r.get<std::uint32_t>("block value count");
         if (count != block_floats) {
           r.fail_at(block_start, block_where + ": " + std::to_string(count) + " values, expected " +

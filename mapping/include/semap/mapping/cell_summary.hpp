@@ -23,6 +23,7 @@ struct CellSummary {
 CellSummary summarize(const LayeredMapParams& params, std::span<const float> fused);
 
 // Probability of each of the K classes of a fused cell.
-std::vector<double> class_probabilities(const LayeredMapParams& params, std::span<const float> fused);
+std::vector<double> class_probabilities(const LayeredMapParams& params,
+                                        std::span<const float> fused);
 
 }  // namespace semap::mapping

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 
 namespace semap::mapping {
@@ -38,6 +39,8 @@ struct LayeredMapParams {
   // Dirichlet prior alpha_0 of S-BKI/S-CSM maps.
   double prior = 0.001;
   LogOddsParams logodds;
+  // Further named parameters kept with the map (e.g. S-BKI's "bki.ell"), stored verbatim.
+  std::map<std::string, double> extra;
 
   // Floats per cell: log-odds maps store occupancy then K label log-odds, S-BKI/S-CSM maps
   // store K Dirichlet evidence increments.

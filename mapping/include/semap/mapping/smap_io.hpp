@@ -31,8 +31,7 @@ struct SmapReadResult {
   LayeredMap map;
   bool complete = true;  // false: salvaged, `problem` says where and why reading stopped
   std::string problem;
-  std::size_t blocks = 0;              // blocks loaded over all layers
-  std::size_t unknown_parameters = 0;  // named parameters this version does not know (skipped)
+  std::size_t blocks = 0;  // blocks loaded over all layers
 };
 
 inline constexpr std::uint32_t kSmapVersion = 1;
