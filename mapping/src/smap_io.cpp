@@ -305,8 +305,8 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
   return result;
 }
 
-void write_smap(const std::filesystem::path& path, const LayeredMap& map) {
-  write_file_atomically(path, encode_smap(map));
+void write_smap(const std::filesystem::path& path, const LayeredMap& map, bool durable) {
+  write_file_atomically(path, encode_smap(map), durable);
 }
 
 SmapReadResult read_smap(const std::filesystem::path& path, const SmapReadOptions& options) {
