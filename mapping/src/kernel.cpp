@@ -23,9 +23,18 @@ KernelTable::KernelTable(const SparseKernel& kernel, int intervals) {
   const double step = static_cast<double>(ell2_) / intervals;
   inv_step_ = static_cast<float>(1.0 / step);
   last_ = static_cast<float>(intervals);
-  values_.resize(static_cast<std::size_t>(intervals) + 1);
+  std::vector<double> values(static_cast<std::size_t>(intervals) + 1);
   for (int i = 0; i <= intervals; ++i) {
-    values_[static_cast<std::size_t>(i)] = static_cast<float>(kernel(std::sqrt(i * step)));
+    values[static_cast<std::size_t>(i)] = kernel(std::sqrt(i * step));
+  }
+  // sqrt rounding may leave the last sample a hair inside the support; it must be exactly 0.
+  values.back() = 0.0;
+  lines_.assign(2 * (static_cast<std::size_t>(intervals) + 1), 0.0f);
+  for (int i = 0; i < intervals; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    const double slope = values[u + 1] - values[u];
+    lines_[2 * u] = static_cast<float>(values[u] - slope * i);
+    lines_[2 * u + 1] = static_cast<float>(slope);
   }
 }
 

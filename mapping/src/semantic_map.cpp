@@ -14,7 +14,7 @@ namespace semap::mapping {
 
 namespace {
 
-// Inclusive range of global cell coordinates per axis.
+// Inclusive range of global cell coordinates per axis; empty when lo > hi.
 struct CellBox {
   std::array<std::int32_t, 3> lo;
   std::array<std::int32_t, 3> hi;
@@ -22,6 +22,16 @@ struct CellBox {
 
 // Malloc bookkeeping per heap allocation, counted so bytes per cell is not flattering.
 constexpr std::size_t kAllocOverhead = 16;
+
+// std::floor/ceil are library calls without SSE4.1; these are exact for |x| < 2^31.
+inline std::int32_t fast_floor(float x) {
+  const auto i = static_cast<std::int32_t>(x);
+  return i - static_cast<std::int32_t>(x < static_cast<float>(i));
+}
+inline std::int32_t fast_ceil(float x) {
+  const auto i = static_cast<std::int32_t>(x);
+  return i + static_cast<std::int32_t>(x > static_cast<float>(i));
+}
 
 // Training points are dropped when their cell coordinates could overflow the block keys.
 bool mappable(const Eigen::Vector3f& p, float inv_res) {
@@ -36,13 +46,17 @@ CellBox support_of(const Eigen::Vector3f& p, const MapParams& params) {
   CellBox box{};
   for (int a = 0; a < 3; ++a) {
     if (params.method == Method::kCsm) {
-      box.lo[a] = box.hi[a] = static_cast<std::int32_t>(std::floor(p[a] * inv_res));
+      box.lo[a] = box.hi[a] = fast_floor(p[a] * inv_res);
     } else {
-      box.lo[a] = static_cast<std::int32_t>(std::ceil((p[a] - params.ell) * inv_res - 0.5f));
-      box.hi[a] = static_cast<std::int32_t>(std::floor((p[a] + params.ell) * inv_res - 0.5f));
+      box.lo[a] = fast_ceil((p[a] - params.ell) * inv_res - 0.5f);
+      box.hi[a] = fast_floor((p[a] + params.ell) * inv_res - 0.5f);
     }
   }
   return box;
+}
+
+bool empty(const CellBox& box) {
+  return box.lo[0] > box.hi[0] || box.lo[1] > box.hi[1] || box.lo[2] > box.hi[2];
 }
 
 // Training point indices grouped by the blocks their support overlaps; points of a block
@@ -51,6 +65,7 @@ struct BlockGroups {
   std::vector<BlockIndex> blocks;
   std::vector<std::uint32_t> offsets;  // blocks.size() + 1
   std::vector<std::uint32_t> points;
+  std::vector<CellBox> boxes;  // support of every training point (empty if unusable)
 };
 
 BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::uint8_t>& usable,
@@ -58,14 +73,16 @@ BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::u
   const std::int32_t n = params.cells_per_side();
   VoxelHashMap ids(training.size() / 4 + 16);
   BlockGroups groups;
+  groups.boxes.resize(training.size(), CellBox{{0, 0, 0}, {-1, -1, -1}});
   std::vector<std::uint32_t> counts;
   // (block id, point index) pairs in point order.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  pairs.reserve(training.size() * 2);
+  pairs.reserve(training.size() * 4);
   for (std::size_t i = 0; i < training.size(); ++i) {
     if (!usable[i]) continue;
     const CellBox box = support_of(training.points[i], params);
-    if (box.lo[0] > box.hi[0] || box.lo[1] > box.hi[1] || box.lo[2] > box.hi[2]) continue;
+    groups.boxes[i] = box;
+    if (empty(box)) continue;
     for (std::int32_t bz = floor_div(box.lo[2], n); bz <= floor_div(box.hi[2], n); ++bz) {
       for (std::int32_t by = floor_div(box.lo[1], n); by <= floor_div(box.hi[1], n); ++by) {
         for (std::int32_t bx = floor_div(box.lo[0], n); bx <= floor_div(box.hi[0], n); ++bx) {
@@ -91,48 +108,69 @@ BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::u
   return groups;
 }
 
-// Adds weight * y_i to one cell.
-inline void accumulate(Block& block, int cell, float weight, const TrainingSet& training,
-                       std::size_t i) {
-  float* alpha = block.cell_evidence_mutable(cell);
-  const std::int32_t label = training.labels[i];
-  if (label >= 0) {
-    alpha[label] += weight;
-  } else {
-    const float* y = training.probabilities.data() + i * training.num_classes;
-    for (int k = 0; k < training.num_classes; ++k) alpha[k] += weight * y[k];
+// Squared distances from a coordinate to the cell centres lo..hi (local) along one axis.
+void axis_distances(float coordinate, std::int32_t first_global, std::int32_t lo, std::int32_t hi,
+                    float res, float* out) {
+  for (std::int32_t c = lo; c <= hi; ++c) {
+    const float d = (static_cast<float>(first_global + c) + 0.5f) * res - coordinate;
+    out[c] = d * d;
   }
-  block.mark_observed(cell);
 }
 
 void update_block(Block& block, const BlockIndex& index, std::span<const std::uint32_t> points,
-                  const TrainingSet& training, const MapParams& params, const KernelTable& kernel) {
+                  const TrainingSet& training, const BlockGroups& groups, const MapParams& params,
+                  const KernelTable& kernel) {
+  constexpr int kMaxSide = 32;  // block_depth <= 6
   const std::int32_t n = params.cells_per_side();
   const std::array<std::int32_t, 3> base{index.x * n, index.y * n, index.z * n};
   const float res = params.resolution;
   const float ell2 = kernel.ell_squared();
+  const std::size_t k = static_cast<std::size_t>(params.num_classes);
+  float* evidence = block.cell_evidence_mutable(0);
+  std::array<std::array<float, kMaxSide>, 3> d2{};
   for (const std::uint32_t i : points) {
-    const Eigen::Vector3f& p = training.points[i];
-    CellBox box = support_of(p, params);
+    CellBox box = groups.boxes[i];
     for (int a = 0; a < 3; ++a) {
       box.lo[a] = std::max(box.lo[a], base[a]) - base[a];
       box.hi[a] = std::min(box.hi[a], base[a] + n - 1) - base[a];
     }
     if (params.method == Method::kCsm) {
-      accumulate(block, block.cell_of(box.lo[0], box.lo[1], box.lo[2]), 1.0f, training, i);
+      const int cell = block.cell_of(box.lo[0], box.lo[1], box.lo[2]);
+      float* alpha = evidence + static_cast<std::size_t>(cell) * k;
+      if (training.labels[i] >= 0) {
+        alpha[training.labels[i]] += 1.0f;
+      } else {
+        const float* y = training.probabilities.data() + i * k;
+        for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
+      }
+      block.mark_observed(cell);
       continue;
     }
+    const Eigen::Vector3f& p = training.points[i];
+    for (int a = 0; a < 3; ++a) {
+      axis_distances(p[a], base[a], box.lo[a], box.hi[a], res, d2[a].data());
+    }
+    const std::int32_t label = training.labels[i];
+    const float* y = label >= 0 ? nullptr : training.probabilities.data() + i * k;
     for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
-      const float dz = (static_cast<float>(base[2] + z) + 0.5f) * res - p.z();
-      for (std::int32_t y = box.lo[1]; y <= box.hi[1]; ++y) {
-        const float dy = (static_cast<float>(base[1] + y) + 0.5f) * res - p.y();
-        const float dyz2 = dz * dz + dy * dy;
+      for (std::int32_t yy = box.lo[1]; yy <= box.hi[1]; ++yy) {
+        const float dyz2 = d2[2][z] + d2[1][yy];
         if (dyz2 >= ell2) continue;
+        // A row of n <= 32 cells starts at a multiple of n, so it lies in one 64-bit word.
+        const int row = block.cell_of(0, yy, z);
+        std::uint64_t touched = 0;
         for (std::int32_t x = box.lo[0]; x <= box.hi[0]; ++x) {
-          const float dx = (static_cast<float>(base[0] + x) + 0.5f) * res - p.x();
-          const float w = kernel(dyz2 + dx * dx);
-          if (w > 0.0f) accumulate(block, block.cell_of(x, y, z), w, training, i);
+          // Beyond ell the table yields exactly 0, so the row needs no sphere test.
+          const float w = kernel(dyz2 + d2[0][x]);
+          float* alpha = evidence + static_cast<std::size_t>(row + x) * k;
+          if (y == nullptr) {
+            alpha[label] += w;
+          } else {
+            for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
+          }
+          touched |= static_cast<std::uint64_t>(w > 0.0f) << ((row + x) & 63);
         }
+        block.mark_observed_word(row >> 6, touched);
       }
     }
   }
@@ -184,7 +222,7 @@ InsertResult SemanticMap::insert(const TrainingSet& training) {
         for (std::size_t b = range.begin(); b != range.end(); ++b) {
           const std::span<const std::uint32_t> points(groups.points.data() + groups.offsets[b],
                                                       groups.offsets[b + 1] - groups.offsets[b]);
-          update_block(*targets[b], groups.blocks[b], points, training, params_, kernel_);
+          update_block(*targets[b], groups.blocks[b], points, training, groups, params_, kernel_);
         }
       });
   result.blocks_updated = groups.blocks.size();

@@ -31,6 +31,8 @@ class Block {
 
   bool observed(int cell) const { return (observed_[cell >> 6] >> (cell & 63)) & 1u; }
   void mark_observed(int cell) { observed_[cell >> 6] |= std::uint64_t{1} << (cell & 63); }
+  // Marks the cells of `mask` in the 64-cell word `word` (cells 64 word .. 64 word + 63).
+  void mark_observed_word(int word, std::uint64_t mask) { observed_[word] |= mask; }
   int num_observed() const;
 
   // Adds evidence for every cell (num_cells * K floats); cells whose added evidence sums to

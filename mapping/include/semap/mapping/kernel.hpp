@@ -1,5 +1,8 @@
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace semap::mapping {
@@ -23,25 +26,25 @@ class SparseKernel {
 };
 
 // The same kernel tabulated over squared distance, so the scatter loop needs neither sqrt nor
-// trigonometry. Linear interpolation over 4096 intervals of d^2 keeps the absolute error below
-// 2e-5 * sf2 (checked by a unit test against SparseKernel).
+// trigonometry. Piecewise linear over `intervals` equal steps of d^2; each step stores
+// (offset, slope) so that k = offset[i] + slope[i] * s with s = d^2 / step, i = floor(s).
+// 1024 intervals (8 KiB, stays in L1) keep the error below 1e-5 * sf2 (unit-tested).
 class KernelTable {
  public:
-  explicit KernelTable(const SparseKernel& kernel, int intervals = 4096);
+  explicit KernelTable(const SparseKernel& kernel, int intervals = 1024);
 
-  // k at squared distance d2; 0 for d2 >= ell^2.
+  // k at squared distance d2; exactly 0 for d2 >= ell^2.
   float operator()(float d2) const {
-    const float x = d2 * inv_step_;
-    if (x >= last_) return 0.0f;
-    const int i = static_cast<int>(x);
-    const float t = x - static_cast<float>(i);
-    return values_[i] + t * (values_[i + 1] - values_[i]);
+    const float s = std::min(d2 * inv_step_, last_);
+    const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
+    return lines_[2 * i] + lines_[2 * i + 1] * s;
   }
 
   float ell_squared() const { return ell2_; }
 
  private:
-  std::vector<float> values_;
+  // Interleaved (offset, slope) per step; the entry at s = intervals is (0, 0).
+  std::vector<float> lines_;
   float inv_step_;
   float last_;
   float ell2_;

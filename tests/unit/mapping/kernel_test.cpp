@@ -1,0 +1,42 @@
+#include "semap/mapping/kernel.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace semap::mapping {
+namespace {
+
+TEST(SparseKernel, MatchesTheClosedFormAndVanishesAtEll) {
+  const SparseKernel k(10.0f, 0.3f);
+  EXPECT_DOUBLE_EQ(k(0.0), 10.0);
+  EXPECT_NEAR(k(0.3), 0.0, 1e-12);
+  EXPECT_EQ(k(0.31), 0.0);
+  // The kernel keeps sf2 and ell as floats.
+  const double d = 0.12, r = d / static_cast<double>(0.3f), a = 2 * std::numbers::pi * r;
+  const double expected =
+      10.0 * ((2 + std::cos(a)) * (1 - r) / 3 + std::sin(a) / (2 * std::numbers::pi));
+  EXPECT_DOUBLE_EQ(k(d), expected);
+  // Monotone decreasing over the support.
+  for (double x = 0.0; x < 0.3; x += 0.01) EXPECT_GE(k(x), k(x + 0.01));
+}
+
+TEST(KernelTable, AgreesWithTheExactKernel) {
+  const SparseKernel exact(10.0f, 0.3f);
+  const KernelTable table(exact);
+  for (int i = 0; i <= 10000; ++i) {
+    const double d = 0.35 * i / 10000.0;
+    EXPECT_NEAR(table(static_cast<float>(d * d)), exact(d), 1e-5 * 10.0) << "d = " << d;
+  }
+  EXPECT_EQ(table(0.09f), 0.0f);
+  EXPECT_EQ(table(1e9f), 0.0f);
+}
+
+TEST(SparseKernel, RejectsNonPositiveParameters) {
+  EXPECT_THROW(SparseKernel(0.0f, 0.3f), std::invalid_argument);
+  EXPECT_THROW(SparseKernel(1.0f, -1.0f), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace semap::mapping
