@@ -1,6 +1,7 @@
 #include "semap/mapping/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -49,6 +50,8 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
   if (fd.get() < 0) fail(path, "creating temporary file", errno);
   const std::filesystem::path temp(name.data());
   try {
+    // mkstemp creates 0600; a map is an ordinary document, readable like any other file.
+    if (::fchmod(fd.get(), 0644) != 0) fail(temp, "fchmod", errno);
     std::size_t written = 0;
     while (written < bytes.size()) {
       const ssize_t n = ::write(fd.get(), bytes.data() + written, bytes.size() - written);

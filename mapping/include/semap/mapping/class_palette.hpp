@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -21,5 +22,10 @@ struct ClassPalette {
   Rgb color(int label) const;
   std::string name(int label) const;
 };
+
+// Reads a palette from YAML: `names: [ground, wall, ...]` and/or `colors: [r, g, b, r, g, b,
+// ...]` (0..255); classes the file leaves out keep the default. Throws common::ConfigError
+// naming the file, line and key for a bad value.
+ClassPalette load_palette(const std::filesystem::path& path, int num_classes);
 
 }  // namespace semap::mapping
