@@ -117,17 +117,59 @@ void axis_distances(float coordinate, std::int32_t first_global, std::int32_t lo
   }
 }
 
+// Adds 1 * y_i to the cell containing training point i (S-CSM).
+void count_point(Block& block, int cell, const TrainingSet& training, std::size_t i) {
+  const std::size_t k = static_cast<std::size_t>(training.num_classes);
+  float* alpha = block.cell_evidence_mutable(cell);
+  if (training.labels[i] >= 0) {
+    alpha[training.labels[i]] += 1.0f;
+  } else {
+    const float* y = training.probabilities.data() + i * k;
+    for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
+  }
+  block.mark_observed(cell);
+}
+
+// Adds k(d) y_i to every cell of `box` (block-local, inclusive) within ell of point i.
+// `d2` holds the squared per-axis distances to the cell centres. Hard labels touch one float
+// per cell, hence the separate instantiation.
+template <bool kSoft>
+void smooth_point(Block& block, const CellBox& box, const std::array<std::array<float, 32>, 3>& d2,
+                  const TrainingSet& training, std::size_t i, const KernelTable& kernel) {
+  const std::size_t k = static_cast<std::size_t>(training.num_classes);
+  const float ell2 = kernel.ell_squared();
+  const float* y = kSoft ? training.probabilities.data() + i * k : nullptr;
+  // For a hard label only column `label` of the cell-major evidence array changes.
+  float* column = block.cell_evidence_mutable(0) + (kSoft ? 0 : training.labels[i]);
+  for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
+    for (std::int32_t yy = box.lo[1]; yy <= box.hi[1]; ++yy) {
+      const float dyz2 = d2[2][z] + d2[1][yy];
+      if (dyz2 >= ell2) continue;
+      // A row of n <= 32 cells starts at a multiple of n, so it lies in one 64-bit word.
+      const int row = block.cell_of(0, yy, z);
+      std::uint64_t touched = 0;
+      for (std::int32_t x = box.lo[0]; x <= box.hi[0]; ++x) {
+        // Beyond ell the table yields exactly 0, so the row needs no sphere test.
+        const float w = kernel(dyz2 + d2[0][x]);
+        float* alpha = column + static_cast<std::size_t>(row + x) * k;
+        if constexpr (kSoft) {
+          for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
+        } else {
+          *alpha += w;
+        }
+        touched |= static_cast<std::uint64_t>(w > 0.0f) << ((row + x) & 63);
+      }
+      block.mark_observed_word(row >> 6, touched);
+    }
+  }
+}
+
 void update_block(Block& block, const BlockIndex& index, std::span<const std::uint32_t> points,
                   const TrainingSet& training, const BlockGroups& groups, const MapParams& params,
                   const KernelTable& kernel) {
-  constexpr int kMaxSide = 32;  // block_depth <= 6
   const std::int32_t n = params.cells_per_side();
   const std::array<std::int32_t, 3> base{index.x * n, index.y * n, index.z * n};
-  const float res = params.resolution;
-  const float ell2 = kernel.ell_squared();
-  const std::size_t k = static_cast<std::size_t>(params.num_classes);
-  float* evidence = block.cell_evidence_mutable(0);
-  std::array<std::array<float, kMaxSide>, 3> d2{};
+  std::array<std::array<float, 32>, 3> d2{};  // n <= 32 for block_depth <= 6
   for (const std::uint32_t i : points) {
     CellBox box = groups.boxes[i];
     for (int a = 0; a < 3; ++a) {
@@ -135,43 +177,17 @@ void update_block(Block& block, const BlockIndex& index, std::span<const std::ui
       box.hi[a] = std::min(box.hi[a], base[a] + n - 1) - base[a];
     }
     if (params.method == Method::kCsm) {
-      const int cell = block.cell_of(box.lo[0], box.lo[1], box.lo[2]);
-      float* alpha = evidence + static_cast<std::size_t>(cell) * k;
-      if (training.labels[i] >= 0) {
-        alpha[training.labels[i]] += 1.0f;
-      } else {
-        const float* y = training.probabilities.data() + i * k;
-        for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
-      }
-      block.mark_observed(cell);
+      count_point(block, block.cell_of(box.lo[0], box.lo[1], box.lo[2]), training, i);
       continue;
     }
     const Eigen::Vector3f& p = training.points[i];
     for (int a = 0; a < 3; ++a) {
-      axis_distances(p[a], base[a], box.lo[a], box.hi[a], res, d2[a].data());
+      axis_distances(p[a], base[a], box.lo[a], box.hi[a], params.resolution, d2[a].data());
     }
-    const std::int32_t label = training.labels[i];
-    const float* y = label >= 0 ? nullptr : training.probabilities.data() + i * k;
-    for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
-      for (std::int32_t yy = box.lo[1]; yy <= box.hi[1]; ++yy) {
-        const float dyz2 = d2[2][z] + d2[1][yy];
-        if (dyz2 >= ell2) continue;
-        // A row of n <= 32 cells starts at a multiple of n, so it lies in one 64-bit word.
-        const int row = block.cell_of(0, yy, z);
-        std::uint64_t touched = 0;
-        for (std::int32_t x = box.lo[0]; x <= box.hi[0]; ++x) {
-          // Beyond ell the table yields exactly 0, so the row needs no sphere test.
-          const float w = kernel(dyz2 + d2[0][x]);
-          float* alpha = evidence + static_cast<std::size_t>(row + x) * k;
-          if (y == nullptr) {
-            alpha[label] += w;
-          } else {
-            for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
-          }
-          touched |= static_cast<std::uint64_t>(w > 0.0f) << ((row + x) & 63);
-        }
-        block.mark_observed_word(row >> 6, touched);
-      }
+    if (training.labels[i] >= 0) {
+      smooth_point<false>(block, box, d2, training, i, kernel);
+    } else {
+      smooth_point<true>(block, box, d2, training, i, kernel);
     }
   }
 }
@@ -267,22 +283,30 @@ int SemanticMap::label_at(const Eigen::Vector3f& point) const {
 }
 
 const Block* SemanticMap::find_block(const BlockIndex& index) const {
-  const auto it = blocks_.find(index);
-  return it == blocks_.end() ? nullptr : &it->second;
+  if (!VoxelHashMap::in_range(index)) return nullptr;
+  const std::uint32_t id = table_.find(index);
+  return id == VoxelHashMap::kNone ? nullptr : &blocks_[id];
 }
 
 Block& SemanticMap::block_at(const BlockIndex& index) {
-  auto it = blocks_.find(index);
-  if (it == blocks_.end()) {
-    it = blocks_
-             .emplace(std::piecewise_construct, std::forward_as_tuple(index),
-                      std::forward_as_tuple(params_.cells_per_side(), params_.num_classes))
-             .first;
+  const std::uint32_t id = table_.insert(index);
+  if (id == blocks_.size()) {
+    indices_.push_back(index);
+    blocks_.emplace_back(params_.cells_per_side(), params_.num_classes);
   }
-  return it->second;
+  return blocks_[id];
 }
 
 void SemanticMap::add_evidence(const BlockIndex& index, std::span<const float> evidence) {
+  if (!VoxelHashMap::in_range(index)) {
+    throw std::invalid_argument("block index beyond the map's +-2^20 range");
+  }
+  const std::size_t expected =
+      static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
+  if (evidence.size() != expected) {
+    throw std::invalid_argument("block evidence has " + std::to_string(evidence.size()) +
+                                " floats, expected " + std::to_string(expected));
+  }
   block_at(index).add_evidence(evidence);
 }
 
@@ -291,15 +315,13 @@ MapStats SemanticMap::stats() const {
   s.blocks = blocks_.size();
   s.scans = scans_;
   s.rejected_points = rejected_;
-  // Hash node: next pointer, key, block object, cached hash; plus the bucket array.
-  constexpr std::size_t kNodeBytes =
-      sizeof(void*) + sizeof(std::pair<const BlockIndex, Block>) + sizeof(std::size_t);
-  s.bytes = blocks_.bucket_count() * sizeof(void*);
-  for (const auto& [index, block] : blocks_) {
+  // Table, index list and the deque's slots, then every block with its two heap arrays.
+  s.bytes =
+      table_.bytes() + indices_.capacity() * sizeof(BlockIndex) + blocks_.size() * sizeof(Block);
+  for (const Block& block : blocks_) {
     s.cells += static_cast<std::size_t>(block.num_cells());
     s.observed_cells += static_cast<std::size_t>(block.num_observed());
-    // The node and the block's two arrays are three heap allocations.
-    s.bytes += kNodeBytes + block.bytes() - sizeof(Block) + 3 * kAllocOverhead;
+    s.bytes += block.bytes() - sizeof(Block) + 2 * kAllocOverhead;
   }
   return s;
 }

@@ -2,10 +2,11 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <span>
-#include <unordered_map>
+#include <vector>
 
 #include "semap/common/messages.hpp"
 #include "semap/mapping/block.hpp"
@@ -14,6 +15,7 @@
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/training_data.hpp"
+#include "semap/mapping/voxel_hash_map.hpp"
 
 namespace semap::mapping {
 
@@ -62,21 +64,22 @@ class SemanticMap {
   // Calls f(const BlockIndex&, const Block&) for every block, in no particular order.
   template <typename F>
   void for_each_block(F&& f) const {
-    for (const auto& [index, block] : blocks_) f(index, block);
+    for (std::size_t b = 0; b < blocks_.size(); ++b) f(indices_[b], blocks_[b]);
   }
   // Calls f(const Eigen::Vector3f& centre, const CellPosterior&) for every observed cell.
   template <typename F>
   void for_each_cell(F&& f) const {
-    for (const auto& [index, block] : blocks_) {
+    for_each_block([&](const BlockIndex& index, const Block& block) {
       for (int c = 0; c < block.num_cells(); ++c) {
         if (!block.observed(c)) continue;
         f(cell_center(index, c), CellPosterior(block.cell_evidence(c), params_.prior, true));
       }
-    }
+    });
   }
 
   const Block* find_block(const BlockIndex& index) const;
   // Adds evidence (cells per block * K floats) to a block, creating it if needed (merging).
+  // Throws std::invalid_argument for a block index beyond +-2^20 or a wrong float count.
   void add_evidence(const BlockIndex& index, std::span<const float> evidence);
 
   BlockIndex block_of(const Eigen::Vector3f& point) const;
@@ -89,8 +92,11 @@ class SemanticMap {
 
   MapParams params_;
   KernelTable kernel_;
-  // Node-based, so Block references stay valid while other blocks are added.
-  std::unordered_map<BlockIndex, Block, BlockIndexHash> blocks_;
+  // The block table: an open-addressing map from block index to the block's position in
+  // blocks_ (a deque, so Block references stay valid while blocks are added).
+  VoxelHashMap table_;
+  std::vector<BlockIndex> indices_;
+  std::deque<Block> blocks_;
   std::size_t scans_ = 0;
   std::size_t rejected_ = 0;
 };

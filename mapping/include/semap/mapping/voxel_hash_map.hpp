@@ -10,7 +10,8 @@ namespace semap::mapping {
 
 // Open-addressing map from integer grid coordinates to dense ids 0, 1, 2, ... in order of
 // first insertion. Used in the per-scan hot loops (voxel downsampling, grouping points by
-// block), where std::unordered_map's node allocations dominate. Coordinates must lie in
+// block) and as the map's block table, where std::unordered_map's node allocations and
+// pointer chasing dominate. Coordinates must lie in
 // [-2^20, 2^20); `in_range` checks that.
 class VoxelHashMap {
  public:
@@ -35,6 +36,10 @@ class VoxelHashMap {
   }
 
   std::size_t size() const { return size_; }
+  // Heap bytes of the table.
+  std::size_t bytes() const {
+    return keys_.capacity() * sizeof(std::uint64_t) + ids_.capacity() * sizeof(std::uint32_t);
+  }
 
   // Id of `v`, inserting it with the next id when absent.
   std::uint32_t insert(const BlockIndex& v) {
