@@ -73,7 +73,7 @@ bool LayeredMap::fused_block(const BlockIndex& key, std::vector<float>& out) con
 }
 
 std::vector<BlockIndex> LayeredMap::block_keys() const {
-  std::unordered_set<BlockIndex, BlockIndexHash> keys;
+  std::unordered_set<BlockIndex, BlockKeyHash> keys;
   for (const auto& [source, grid] : layers_) {
     for (const auto& [key, block] : grid.blocks()) keys.insert(key);
   }

@@ -12,7 +12,7 @@ namespace {
 
 struct CellHash {
   std::size_t operator()(const CellIndex& c) const {
-    return BlockIndexHash{}(BlockIndex{c.x(), c.y(), c.z()});
+    return BlockKeyHash{}(BlockIndex{c.x(), c.y(), c.z()});
   }
 };
 

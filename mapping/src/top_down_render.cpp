@@ -42,7 +42,7 @@ void write_top_down_pngs(const std::filesystem::path& class_png,
   // Highest occupied cell of each (x, y) column.
   Eigen::Vector2i lo(std::numeric_limits<int>::max(), std::numeric_limits<int>::max());
   Eigen::Vector2i hi(std::numeric_limits<int>::min(), std::numeric_limits<int>::min());
-  std::unordered_map<BlockIndex, Column, BlockIndexHash> columns;
+  std::unordered_map<BlockIndex, Column, BlockKeyHash> columns;
   for (const OccupiedCell& c : cells) {
     const CellIndex cell = cell_of_point(c.centre, resolution);
     lo = lo.cwiseMin(cell.head<2>());

@@ -16,7 +16,7 @@ namespace semap::mapping {
 class EvidenceGrid {
  public:
   using Block = std::vector<float>;
-  using BlockMap = std::unordered_map<BlockIndex, Block, BlockIndexHash>;
+  using BlockMap = std::unordered_map<BlockIndex, Block, BlockKeyHash>;
 
   EvidenceGrid(int block_side, int channels);
 

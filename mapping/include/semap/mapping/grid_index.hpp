@@ -13,6 +13,16 @@ namespace semap::mapping {
 using CellIndex = Eigen::Vector3i;
 // Blocks (semap/mapping/block_index.hpp) hold block_side^3 cells: block = floor(cell / side).
 
+// Hash of a block (or cell) index for the standard unordered containers.
+struct BlockKeyHash {
+  std::size_t operator()(const BlockIndex& key) const {
+    // Large odd primes spread neighbouring blocks over the buckets.
+    return static_cast<std::size_t>(key.x) * 73856093u ^
+           static_cast<std::size_t>(key.y) * 19349663u ^
+           static_cast<std::size_t>(key.z) * 83492791u;
+  }
+};
+
 inline CellIndex cell_of_point(const Eigen::Vector3d& point, double resolution) {
   return CellIndex(static_cast<int>(std::floor(point.x() / resolution)),
                    static_cast<int>(std::floor(point.y() / resolution)),

@@ -26,7 +26,7 @@ class TileStore {
   bool restore(LayeredMap& map, const BlockIndex& key);
 
   bool contains(const BlockIndex& key) const { return keys_.contains(key); }
-  const std::unordered_set<BlockIndex, BlockIndexHash>& keys() const { return keys_; }
+  const std::unordered_set<BlockIndex, BlockKeyHash>& keys() const { return keys_; }
   std::size_t size() const { return keys_.size(); }
   std::filesystem::path tile_path(const BlockIndex& key) const;
 
@@ -34,7 +34,7 @@ class TileStore {
   std::filesystem::path dir_;
   LayeredMapParams params_;
   bool durable_;
-  std::unordered_set<BlockIndex, BlockIndexHash> keys_;
+  std::unordered_set<BlockIndex, BlockKeyHash> keys_;
 };
 
 }  // namespace semap::mapping
