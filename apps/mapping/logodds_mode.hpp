@@ -37,7 +37,8 @@ inline void run_logodds(const mapping::MapParams& params,
                         const std::vector<common::LabeledCloud>& clouds, const LogOddsRun& run) {
   mapping::LogOddsMap map(logodds_params(params), run.robot);
   const auto start = std::chrono::steady_clock::now();
-  for (const auto& cloud : clouds) map.insert(cloud);
+  std::size_t rejected = 0;
+  for (const auto& cloud : clouds) rejected += map.insert(cloud).rejected;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const auto cells = mapping::occupied_cells(map.layers());
@@ -60,8 +61,10 @@ inline void run_logodds(const mapping::MapParams& params,
     }
   }
   if (!run.save_path.empty()) mapping::write_smap(run.save_path, map.layers());
-  std::printf("method logodds\nscans %zu\nblocks %zu\noccupied_cells %zu\ninsert_seconds %.6f\n",
-              clouds.size(), map.layers().resident_blocks(), cells.size(), seconds);
+  std::printf(
+      "method logodds\nscans %zu\nrejected_points %zu\nblocks %zu\noccupied_cells %zu\n"
+      "insert_seconds %.6f\n",
+      clouds.size(), rejected, map.layers().resident_blocks(), cells.size(), seconds);
 }
 
 }  // namespace semap::apps

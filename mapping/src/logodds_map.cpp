@@ -31,7 +31,7 @@ LogOddsMap::LogOddsMap(LayeredMap map, SourceId robot)
   }
 }
 
-void LogOddsMap::insert(const common::LabeledCloud& cloud) {
+LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
   const LayeredMapParams& p = map_.params();
   const auto k = static_cast<std::size_t>(p.num_classes);
   if (cloud.has_probabilities() ? cloud.probabilities.size() != cloud.size() * k
@@ -50,21 +50,28 @@ void LogOddsMap::insert(const common::LabeledCloud& cloud) {
   const Eigen::Vector3d origin = cloud.origin.cast<double>();
   CellSet hits;
   CellSet free;
+  LogOddsInsertResult result;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d point = cloud.points[i].cast<double>();
-    if (!point.allFinite()) continue;
+    if (!point.allFinite() || (!cloud.has_probabilities() && cloud.labels[i] >= k)) {
+      ++result.rejected;
+      continue;
+    }
     const Eigen::Vector3d ray = point - origin;
     const double range = ray.norm();
     const bool in_range = range <= p.logodds.max_range;
     const Eigen::Vector3d end = in_range ? point : origin + ray * (p.logodds.max_range / range);
     traverse_ray(origin, end, p.resolution, [&](const CellIndex& c) { free.insert(c); });
-    if (!in_range) continue;
+    if (!in_range) {
+      ++result.out_of_range;
+      continue;
+    }
     const CellIndex cell = cell_of_point(point, p.resolution);
     hits.insert(cell);
     const std::span<float> labels = grid.cell(cell).subspan(1);
     if (cloud.has_probabilities()) {
       model_.add_label_probabilities(labels, std::span(cloud.probabilities).subspan(i * k, k));
-    } else if (cloud.labels[i] < k) {
+    } else {
       model_.add_hard_label(labels, cloud.labels[i]);
     }
   }
@@ -76,8 +83,11 @@ void LogOddsMap::insert(const common::LabeledCloud& cloud) {
     if (hits.contains(cell)) continue;
     float& occ = grid.cell(cell)[0];
     occ = model_.clamp(occ + model_.miss());
+    ++result.free_cells;
   }
+  result.hit_cells = hits.size();
   grid.set_updates(grid.updates() + 1);
+  return result;
 }
 
 CellSummary LogOddsMap::summary(const CellIndex& cell) const {

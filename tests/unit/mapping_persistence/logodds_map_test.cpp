@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "semap/mapping/ray_traversal.hpp"
@@ -114,6 +115,22 @@ TEST(LogOddsMap, BeamsBeyondMaxRangeOnlyClearSpace) {
   EXPECT_FALSE(map.summary({20, 0, 0}).known);
   EXPECT_NEAR(map.occupancy_probability({3, 0, 0}), 0.4, 1e-5);
   EXPECT_FALSE(map.summary({6, 0, 0}).known);
+}
+
+TEST(LogOddsMap, CountsBadPointsAndSkipsThem) {
+  LogOddsMap map(logodds_params(4), 1);
+  common::LabeledCloud cloud;
+  cloud.points = {{0.55f, 0.05f, 0.05f},
+                  {std::nanf(""), 0.0f, 0.0f},
+                  {0.05f, 0.55f, 0.05f},
+                  {90.0f, 0.05f, 0.05f}};
+  cloud.labels = {1, 1, 9, 2};
+  const LogOddsInsertResult r = map.insert(cloud);
+  EXPECT_EQ(r.rejected, 2u);
+  EXPECT_EQ(r.out_of_range, 1u);
+  EXPECT_EQ(r.hit_cells, 1u);
+  EXPECT_GT(r.free_cells, 100u);
+  EXPECT_FALSE(map.summary_at({0.05, 0.55, 0.05}).occupied);
 }
 
 TEST(LogOddsMap, RejectsCloudWithMismatchedLabels) {

@@ -10,6 +10,14 @@
 
 namespace semap::mapping {
 
+// What one LogOddsMap::insert did.
+struct LogOddsInsertResult {
+  std::size_t hit_cells = 0;
+  std::size_t free_cells = 0;
+  std::size_t out_of_range = 0;  // beams longer than max_range (space cleared, no hit)
+  std::size_t rejected = 0;      // non-finite points and labels >= K, skipped
+};
+
 // Log-odds semantic occupancy map (Yue et al., "Probabilistic 3D Semantic Map Fusion Based on
 // Bayesian Rule"). Each scan updates the local robot's evidence layer: every cell a beam ends
 // in gets one hit per scan plus one label measurement per point, every cell a beam crosses
@@ -23,7 +31,8 @@ class LogOddsMap {
   LogOddsMap(LayeredMap map, SourceId robot);
 
   // Integrates one labelled scan whose points and origin are in the map frame.
-  void insert(const common::LabeledCloud& cloud);
+  // Throws std::invalid_argument when the label arrays do not match the points.
+  LogOddsInsertResult insert(const common::LabeledCloud& cloud);
 
   CellSummary summary(const CellIndex& cell) const;
   CellSummary summary_at(const Eigen::Vector3d& point) const {
