@@ -1,6 +1,7 @@
 #include "semap/mapping/block.hpp"
 
 #include <bit>
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -15,8 +16,11 @@ std::size_t words_for(int cells) { return (static_cast<std::size_t>(cells) + 63)
 Block::Block(int cells_per_side, int num_classes)
     : n_(cells_per_side),
       k_(num_classes),
-      evidence_(new float[static_cast<std::size_t>(num_cells()) * num_classes]()),
-      observed_(new std::uint64_t[words_for(num_cells())]()) {}
+      evidence_(static_cast<float*>(
+          std::calloc(static_cast<std::size_t>(num_cells()) * num_classes, sizeof(float)))),
+      observed_(new std::uint64_t[words_for(num_cells())]()) {
+  if (!evidence_) throw std::bad_alloc();
+}
 
 std::span<const float> Block::evidence() const {
   return {evidence_.get(), static_cast<std::size_t>(num_cells()) * k_};

@@ -40,7 +40,7 @@ bool mappable(const Eigen::Vector3f& p, float inv_res) {
 }
 
 // Cells a training point touches: for S-BKI all cells whose centre lies within ell per
-// axis (the sphere test follows per cell), for S-CSM the cell containing the point.
+// axis (rows are trimmed to the sphere later), for S-CSM the cell containing the point.
 CellBox support_of(const Eigen::Vector3f& p, const MapParams& params) {
   const float inv_res = 1.0f / params.resolution;
   CellBox box{};
@@ -147,9 +147,13 @@ void smooth_point(Block& block, const CellBox& box, const std::array<std::array<
       if (dyz2 >= ell2) continue;
       // A row of n <= 32 cells starts at a multiple of n, so it lies in one 64-bit word.
       const int row = block.cell_of(0, yy, z);
-      std::uint64_t touched = 0;
-      for (std::int32_t x = box.lo[0]; x <= box.hi[0]; ++x) {
-        // Beyond ell the table yields exactly 0, so the row needs no sphere test.
+      // Trim the row to the sphere; distances along x are convex, so both ends suffice.
+      const float rest = ell2 - dyz2;
+      std::int32_t x_lo = box.lo[0], x_hi = box.hi[0];
+      while (x_lo <= x_hi && d2[0][x_lo] >= rest) ++x_lo;
+      while (x_hi >= x_lo && d2[0][x_hi] >= rest) --x_hi;
+      if (x_lo > x_hi) continue;
+      for (std::int32_t x = x_lo; x <= x_hi; ++x) {
         const float w = kernel(dyz2 + d2[0][x]);
         float* alpha = column + static_cast<std::size_t>(row + x) * k;
         if constexpr (kSoft) {
@@ -157,9 +161,10 @@ void smooth_point(Block& block, const CellBox& box, const std::array<std::array<
         } else {
           *alpha += w;
         }
-        touched |= static_cast<std::uint64_t>(w > 0.0f) << ((row + x) & 63);
       }
-      block.mark_observed_word(row >> 6, touched);
+      // Every cell centre strictly inside the support counts as observed.
+      const std::uint64_t run = (std::uint64_t{2} << (x_hi - x_lo)) - 1;
+      block.mark_observed_word(row >> 6, run << ((row + x_lo) & 63));
     }
   }
 }
@@ -247,10 +252,12 @@ InsertResult SemanticMap::insert(const TrainingSet& training) {
 }
 
 BlockIndex SemanticMap::block_of(const Eigen::Vector3f& point) const {
-  const float inv = 1.0f / params_.block_size();
-  return {static_cast<std::int32_t>(std::floor(point.x() * inv)),
-          static_cast<std::int32_t>(std::floor(point.y() * inv)),
-          static_cast<std::int32_t>(std::floor(point.z() * inv))};
+  // Through the cell index, exactly as insert() and query() do, so boundaries agree.
+  const float inv_res = 1.0f / params_.resolution;
+  const std::int32_t n = params_.cells_per_side();
+  return {floor_div(fast_floor(point.x() * inv_res), n),
+          floor_div(fast_floor(point.y() * inv_res), n),
+          floor_div(fast_floor(point.z() * inv_res), n)};
 }
 
 Eigen::Vector3f SemanticMap::cell_center(const BlockIndex& block, int cell) const {

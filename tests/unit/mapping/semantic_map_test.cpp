@@ -261,6 +261,17 @@ TEST(SemanticMap, BadPointsAreCountedNotFatal) {
   EXPECT_FALSE(map.query(Eigen::Vector3f(std::nanf(""), 0, 0)).has_value());
 }
 
+TEST(SemanticMap, CellCentresLieInTheirBlock) {
+  const SemanticMap map(bki_params());
+  for (const BlockIndex b : {BlockIndex{0, 0, 0}, BlockIndex{-1, 2, -3}, BlockIndex{7, -8, 0}}) {
+    for (const int cell : {0, 5, 63}) {
+      EXPECT_EQ(map.block_of(map.cell_center(b, cell)), b) << cell;
+    }
+  }
+  // Negative coordinates floor towards minus infinity.
+  EXPECT_EQ(map.block_of(Eigen::Vector3f(-0.01f, 0.39f, 0.41f)), (BlockIndex{-1, 0, 1}));
+}
+
 TEST(SemanticMap, RejectsBadParameters) {
   MapParams p;
   p.resolution = 0.0f;

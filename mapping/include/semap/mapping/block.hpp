@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <span>
 
@@ -9,8 +10,9 @@ namespace semap::mapping {
 
 // A dense cube of cells_per_side^3 cells. Per cell it stores K floats of Dirichlet evidence
 // (alpha minus the prior, so blocks from different maps can simply be added) and one bit
-// that says whether the cell ever received evidence. Cell c = (z * n + y) * n + x holds
-// evidence()[c * K .. c * K + K).
+// that says whether the cell was ever observed: covered by a training point's support (S-BKI:
+// centre strictly within ell; S-CSM: the point lies in the cell) or given positive evidence. Cell c
+// = (z * n + y) * n + x holds evidence()[c * K .. c * K + K).
 class Block {
  public:
   Block(int cells_per_side, int num_classes);
@@ -43,9 +45,15 @@ class Block {
   std::size_t bytes() const;
 
  private:
+  // calloc'd: fresh pages arrive zeroed from the kernel, so a new block costs no memset and
+  // its first touch happens in the (parallel) update rather than at creation.
+  struct FreeDeleter {
+    void operator()(float* p) const { std::free(p); }
+  };
+
   int n_;
   int k_;
-  std::unique_ptr<float[]> evidence_;
+  std::unique_ptr<float[], FreeDeleter> evidence_;
   std::unique_ptr<std::uint64_t[]> observed_;
 };
 
