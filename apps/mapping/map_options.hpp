@@ -17,7 +17,8 @@ struct MapOptions {
 };
 
 inline void add_map_options(CLI::App& app, MapOptions& o) {
-  app.add_option("--method", o.method, "bki or csm")->check(CLI::IsMember({"bki", "csm"}));
+  app.add_option("--method", o.method, "bki, csm (or logodds in semap-map)")
+      ->check(CLI::IsMember({"bki", "csm", "logodds"}));
   app.add_option("--resolution", o.flags.resolution, "cell size, m");
   app.add_option("--block-depth", o.flags.block_depth, "block holds (2^(depth-1))^3 cells");
   app.add_option("--num-classes", o.flags.num_classes, "K, class 0 = free");

@@ -11,10 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "logodds_mode.hpp"
 #include "map_options.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/pcd_io.hpp"
+#include "semap/mapping/semantic_layers.hpp"
 #include "semap/mapping/semantic_map.hpp"
 
 int main(int argc, char** argv) {
@@ -28,11 +30,17 @@ int main(int argc, char** argv) {
   app.add_option("--out-voxels", out_voxels, "CSV x,y,z,label of occupied cell centres");
   app.add_option("--query-out", query_out, "map class (or -1) at every input point");
   app.add_option("--log-level", log_level, "trace..off");
+  semap::apps::LogOddsRun logodds_run;
+  app.add_option("--save", logodds_run.save_path, "write the map as .smap (any method)");
+  app.add_option("--robot-id", logodds_run.robot, "source id of this robot's evidence in .smap");
   app.add_option("scans", scans, "PCD scans, inserted in order")->required();
   CLI11_PARSE(app, argc, argv);
   semap::common::setup_logging(log_level);
 
   try {
+    // The log-odds map reads the shared grid flags from the S-BKI parameters.
+    const bool logodds = options.method == "logodds";
+    if (logodds) options.method = "bki";
     const semap::mapping::MapParams params = semap::apps::resolve_map_params(app, options);
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0) {
@@ -42,6 +50,12 @@ int main(int argc, char** argv) {
     std::vector<semap::common::LabeledCloud> clouds;
     for (const auto& path : scans) clouds.push_back(semap::mapping::read_pcd(path).cloud);
 
+    if (logodds) {
+      logodds_run.out_voxels = out_voxels;
+      logodds_run.query_out = query_out;
+      semap::apps::run_logodds(params, clouds, logodds_run);
+      return 0;
+    }
     semap::mapping::SemanticMap map(params);
     std::size_t rejected = 0;
     const auto start = std::chrono::steady_clock::now();
@@ -65,6 +79,10 @@ int main(int argc, char** argv) {
       for (const auto& cloud : clouds) {
         for (const auto& p : cloud.points) out << map.label_at(p) << '\n';
       }
+    }
+    if (!logodds_run.save_path.empty()) {
+      semap::mapping::write_smap(logodds_run.save_path,
+                                 semap::mapping::to_layered_map(map, logodds_run.robot));
     }
     const auto stats = map.stats();
     std::printf("method %s\nscans %zu\nrejected_points %zu\nblocks %zu\ncells %zu\n",

@@ -1,0 +1,45 @@
+#include "semap/mapping/cell_summary.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include "semap/mapping/logodds.hpp"
+
+namespace semap::mapping {
+
+std::vector<double> class_probabilities(const LayeredMapParams& params,
+                                        std::span<const float> fused) {
+  std::vector<double> p(static_cast<std::size_t>(params.num_classes));
+  if (params.method == MapMethod::kLogOdds) {
+    LogOddsModel::probabilities(fused.subspan(1), p);
+    return p;
+  }
+  const double sum = std::accumulate(fused.begin(), fused.end(), 0.0);
+  for (std::size_t c = 0; c < p.size(); ++c) p[c] = fused[c] / sum;
+  return p;
+}
+
+CellSummary summarize(const LayeredMapParams& params, std::span<const float> fused) {
+  CellSummary s;
+  const std::vector<double> p = class_probabilities(params, fused);
+  const auto best = std::max_element(p.begin(), p.end());
+  s.label = static_cast<int>(best - p.begin());
+  s.probability = static_cast<float>(*best);
+  if (params.method == MapMethod::kLogOdds) {
+    s.known = std::any_of(fused.begin(), fused.end(), [](float v) { return v != 0.0f; });
+    s.occupancy = static_cast<float>(sigmoid(fused[0]));
+    s.occupied = fused[0] > 0.0f;
+    s.variance = s.probability * (1.0f - s.probability);
+    return s;
+  }
+  const double alpha0 = std::accumulate(fused.begin(), fused.end(), 0.0);
+  const auto prior = static_cast<float>(params.prior);
+  s.known = std::any_of(fused.begin(), fused.end(), [&](float v) { return v > prior; });
+  s.occupancy = static_cast<float>(1.0 - p[0]);
+  s.occupied = s.known && s.label != 0;
+  const double a = fused[static_cast<std::size_t>(s.label)];
+  s.variance = static_cast<float>(a * (alpha0 - a) / (alpha0 * alpha0 * (alpha0 + 1.0)));
+  return s;
+}
+
+}  // namespace semap::mapping

@@ -1,0 +1,111 @@
+#include "semap/mapping/logodds_map.hpp"
+
+#include <stdexcept>
+#include <string>
+#include <unordered_set>
+
+#include "semap/mapping/ray_traversal.hpp"
+
+namespace semap::mapping {
+
+namespace {
+
+struct CellHash {
+  std::size_t operator()(const CellIndex& c) const {
+    return BlockKeyHash{}(BlockIndex{c.x(), c.y(), c.z()});
+  }
+};
+
+using CellSet = std::unordered_set<CellIndex, CellHash>;
+
+}  // namespace
+
+LogOddsMap::LogOddsMap(const LayeredMapParams& params, SourceId robot)
+    : LogOddsMap(LayeredMap(params), robot) {}
+
+LogOddsMap::LogOddsMap(LayeredMap map, SourceId robot)
+    : map_(std::move(map)), robot_(robot), model_(map_.params().logodds) {
+  if (map_.params().method != MapMethod::kLogOdds) {
+    throw std::invalid_argument("LogOddsMap needs a map of method logodds, got " +
+                                to_string(map_.params().method));
+  }
+}
+
+LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
+  const LayeredMapParams& p = map_.params();
+  const auto k = static_cast<std::size_t>(p.num_classes);
+  if (cloud.has_probabilities() ? cloud.probabilities.size() != cloud.size() * k
+                                : cloud.labels.size() != cloud.size()) {
+    throw std::invalid_argument("LogOddsMap::insert: cloud of " + std::to_string(cloud.size()) +
+                                " points has " + std::to_string(cloud.labels.size()) +
+                                " labels and " + std::to_string(cloud.probabilities.size()) +
+                                " probabilities for " + std::to_string(k) + " classes");
+  }
+  if (cloud.has_probabilities() && cloud.num_classes != k) {
+    throw std::invalid_argument("LogOddsMap::insert: cloud has " +
+                                std::to_string(cloud.num_classes) + " classes, map " +
+                                std::to_string(k));
+  }
+  EvidenceGrid& grid = map_.layer(robot_);
+  const Eigen::Vector3d origin = cloud.origin.cast<double>();
+  CellSet hits;
+  CellSet free;
+  LogOddsInsertResult result;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d point = cloud.points[i].cast<double>();
+    if (!point.allFinite() || (!cloud.has_probabilities() && cloud.labels[i] >= k)) {
+      ++result.rejected;
+      continue;
+    }
+    const Eigen::Vector3d ray = point - origin;
+    const double range = ray.norm();
+    const bool in_range = range <= p.logodds.max_range;
+    const Eigen::Vector3d end = in_range ? point : origin + ray * (p.logodds.max_range / range);
+    traverse_ray(origin, end, p.resolution, [&](const CellIndex& c) { free.insert(c); });
+    if (!in_range) {
+      ++result.out_of_range;
+      continue;
+    }
+    const CellIndex cell = cell_of_point(point, p.resolution);
+    hits.insert(cell);
+    const std::span<float> labels = grid.cell(cell).subspan(1);
+    if (cloud.has_probabilities()) {
+      model_.add_label_probabilities(labels, std::span(cloud.probabilities).subspan(i * k, k));
+    } else {
+      model_.add_hard_label(labels, cloud.labels[i]);
+    }
+  }
+  for (const CellIndex& cell : hits) {
+    float& occ = grid.cell(cell)[0];
+    occ = model_.clamp(occ + model_.hit());
+  }
+  for (const CellIndex& cell : free) {
+    if (hits.contains(cell)) continue;
+    float& occ = grid.cell(cell)[0];
+    occ = model_.clamp(occ + model_.miss());
+    ++result.free_cells;
+  }
+  result.hit_cells = hits.size();
+  grid.set_updates(grid.updates() + 1);
+  return result;
+}
+
+CellSummary LogOddsMap::summary(const CellIndex& cell) const {
+  std::vector<float> fused(static_cast<std::size_t>(map_.params().channels()));
+  map_.fused(cell, fused);
+  return summarize(map_.params(), fused);
+}
+
+std::vector<double> LogOddsMap::class_probabilities(const CellIndex& cell) const {
+  std::vector<float> fused(static_cast<std::size_t>(map_.params().channels()));
+  map_.fused(cell, fused);
+  return mapping::class_probabilities(map_.params(), fused);
+}
+
+double LogOddsMap::occupancy_probability(const CellIndex& cell) const {
+  std::vector<float> fused(static_cast<std::size_t>(map_.params().channels()));
+  map_.fused(cell, fused);
+  return sigmoid(fused[0]);
+}
+
+}  // namespace semap::mapping

@@ -1,0 +1,90 @@
+#include "semap/mapping/map_merge.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace semap::mapping {
+
+namespace {
+
+bool is_identity(const Eigen::Isometry3d& T) {
+  return T.matrix().isApprox(Eigen::Matrix4d::Identity(), 1e-12);
+}
+
+bool any_nonzero(std::span<const float> values) {
+  return std::any_of(values.begin(), values.end(), [](float v) { return v != 0.0f; });
+}
+
+}  // namespace
+
+EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& from_params,
+                            const LayeredMapParams& to_params, const Eigen::Isometry3d& T_to_from) {
+  EvidenceGrid out(to_params.block_side(), to_params.channels());
+  out.set_updates(layer.updates());
+  if (is_identity(T_to_from) && from_params.resolution == to_params.resolution &&
+      from_params.block_side() == to_params.block_side()) {
+    for (const auto& [key, block] : layer.blocks()) out.put_block(key, block);
+    return out;
+  }
+  const Eigen::Isometry3d T_from_to = T_to_from.inverse();
+  const int side = from_params.block_side();
+  const double from_res = from_params.resolution;
+  const double to_res = to_params.resolution;
+  const auto channels = static_cast<std::size_t>(to_params.channels());
+  for (const auto& [key, block] : layer.blocks()) {
+    // Bounding box of the source block in the target frame; every target cell whose centre
+    // maps back into this block lies inside it.
+    const Eigen::Vector3d lo =
+        Eigen::Vector3d(key.x, key.y, key.z) * static_cast<double>(side) * from_res;
+    Eigen::Vector3d box_min = Eigen::Vector3d::Constant(1e300);
+    Eigen::Vector3d box_max = Eigen::Vector3d::Constant(-1e300);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d offset((corner & 1) ? 1.0 : 0.0, (corner & 2) ? 1.0 : 0.0,
+                                   (corner & 4) ? 1.0 : 0.0);
+      const Eigen::Vector3d p = T_to_from * (lo + offset * side * from_res);
+      box_min = box_min.cwiseMin(p);
+      box_max = box_max.cwiseMax(p);
+    }
+    const CellIndex first = cell_of_point(box_min, to_res);
+    const CellIndex last = cell_of_point(box_max, to_res);
+    for (int z = first.z(); z <= last.z(); ++z) {
+      for (int y = first.y(); y <= last.y(); ++y) {
+        for (int x = first.x(); x <= last.x(); ++x) {
+          const CellIndex target(x, y, z);
+          const CellIndex source = cell_of_point(T_from_to * cell_centre(target, to_res), from_res);
+          if (block_of_cell(source, side) != key) continue;
+          const auto offset = static_cast<std::size_t>(local_index(source, key, side)) * channels;
+          const std::span<const float> values(block.data() + offset, channels);
+          if (!any_nonzero(values)) continue;
+          std::copy(values.begin(), values.end(), out.cell(target).begin());
+        }
+      }
+    }
+  }
+  return out;
+}
+
+MergeReport merge_into(LayeredMap& a, const LayeredMap& b, const Eigen::Isometry3d& T_ab) {
+  const LayeredMapParams& pa = a.params();
+  const LayeredMapParams& pb = b.params();
+  if (pa.method != pb.method || pa.num_classes != pb.num_classes) {
+    throw std::invalid_argument("merge: cannot merge a " + to_string(pb.method) + " map of " +
+                                std::to_string(pb.num_classes) + " classes into a " +
+                                to_string(pa.method) + " map of " + std::to_string(pa.num_classes) +
+                                " classes");
+  }
+  MergeReport report;
+  for (const auto& [source, layer] : b.layers()) {
+    const EvidenceGrid* existing = a.find_layer(source);
+    if (existing != nullptr && existing->updates() >= layer.updates()) {
+      ++report.layers_kept;
+      continue;
+    }
+    (existing == nullptr ? report.layers_added : report.layers_replaced) += 1;
+    a.set_layer(source, resample_layer(layer, pb, pa, T_ab));
+  }
+  return report;
+}
+
+}  // namespace semap::mapping

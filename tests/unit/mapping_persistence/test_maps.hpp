@@ -1,0 +1,47 @@
+#pragma once
+
+#include <random>
+
+#include "semap/mapping/layered_map.hpp"
+#include "semap/mapping/logodds_map.hpp"
+
+namespace semap::mapping::testing {
+
+inline LayeredMapParams small_logodds_params() {
+  LayeredMapParams p;
+  p.method = MapMethod::kLogOdds;
+  p.resolution = 0.1;
+  p.block_depth = 3;
+  p.num_classes = 4;
+  return p;
+}
+
+// A log-odds map with two robots' layers built from random labelled beams.
+inline LayeredMap random_logodds_map(std::uint32_t seed, int scans = 4, int points = 60) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> coord(-1.5f, 1.5f);
+  std::uniform_int_distribution<int> label(1, 3);
+  LogOddsMap a(small_logodds_params(), 1);
+  for (int s = 0; s < scans; ++s) {
+    common::LabeledCloud cloud;
+    cloud.origin = Eigen::Vector3f(coord(rng), coord(rng), 0.3f) * 0.3f;
+    for (int i = 0; i < points; ++i) {
+      cloud.points.emplace_back(coord(rng), coord(rng), coord(rng) * 0.3f);
+      cloud.labels.push_back(static_cast<std::uint16_t>(label(rng)));
+    }
+    a.insert(cloud);
+  }
+  LayeredMap map = a.layers();
+  // A second robot's layer with different evidence.
+  LogOddsMap b(small_logodds_params(), 2);
+  common::LabeledCloud cloud;
+  for (int i = 0; i < points; ++i) {
+    cloud.points.emplace_back(coord(rng), coord(rng), coord(rng));
+    cloud.labels.push_back(static_cast<std::uint16_t>(label(rng)));
+  }
+  b.insert(cloud);
+  map.set_layer(2, *b.layers().find_layer(2));
+  return map;
+}
+
+}  // namespace semap::mapping::testing
