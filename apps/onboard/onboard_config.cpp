@@ -116,6 +116,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   c.map = mapping::map_params_from_config(map, c.map);
   c.map_save_path = map.get<std::string>("save_path", "");
   c.map_threads = static_cast<int>(map.get_in_range("threads", 2, 1, 64));
+  c.robot_id = static_cast<mapping::SourceId>(map.get_in_range("robot_id", 1, 1, 65535));
   map.finish();
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);

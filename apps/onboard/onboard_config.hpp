@@ -13,6 +13,7 @@
 #include "semap/firmware_bridge/emulator.hpp"
 #include "semap/mapping/depth_projection.hpp"
 #include "semap/mapping/map_params.hpp"
+#include "semap/mapping/semantic_layers.hpp"
 
 namespace semap::onboard {
 
@@ -75,7 +76,8 @@ struct OnboardConfig {
   CameraConfig camera;
   estimation::EstimatorConfig estimator;
   mapping::MapParams map;
-  std::string map_save_path;
+  std::string map_save_path;  // .smap written at exit when set
+  mapping::SourceId robot_id = 1;  // this robot's evidence layer in saved and merged maps
   int map_threads = 2;
   DdsConfig dds;
   std::string log_level = "info";

@@ -2,9 +2,9 @@
 # semap-onboard on the simulated rig for 20 s while semap-map-listener follows the map over
 # DDS on loopback. Passes when the robot initialised, its pose stayed within 1 m of the
 # simulated truth, it mapped (nearly) every posed image, and the listener received blocks with no
-# rejections.
+# rejections, and the map it saved at exit exports to a top-down PNG.
 set -euo pipefail
-onboard="$1" listener="$2" config="$3" xml="$4"
+onboard="$1" listener="$2" config="$3" xml="$4" exporter="$5"
 export CYCLONEDDS_URI="file://$xml"
 domain=$(( (RANDOM % 200) + 20 ))
 work=$(mktemp -d)
@@ -13,6 +13,7 @@ trap 'rm -rf "$work"' EXIT
 "$listener" --domain "$domain" --seconds 40 --expect-blocks 2000 --classes 4 \
   --save "$work/received.pcd" >"$work/listener.log" 2>&1 &
 listener_pid=$!
+rm -f build/sim_map.smap
 "$onboard" --config "$config" --duration 20 --domain "$domain" >"$work/onboard.log" 2>&1 || {
   echo "semap-onboard failed"; cat "$work/onboard.log"; exit 1; }
 wait "$listener_pid" || { echo "listener failed"; cat "$work/listener.log"; exit 1; }
@@ -33,4 +34,7 @@ blocks=$(awk '{print $3}' <<<"$last")
 rejected=$(awk '{print $7}' <<<"$last")
 [[ "$blocks" -ge 2000 && "$rejected" -eq 0 ]] || { echo "listener: $last"; exit 1; }
 [[ -s "$work/received.pcd" ]] || { echo "listener saved no map"; exit 1; }
+"$exporter" build/sim_map.smap --png "$work/top.png" --ply "$work/map.ply" >"$work/export.log" 2>&1 || {
+  echo "semap-export failed on the saved map"; cat "$work/export.log"; exit 1; }
+[[ -s "$work/top.png" && -s "$work/map.ply" ]] || { echo "export wrote nothing"; exit 1; }
 echo "e2e: rmse ${rmse} m, ${scans} scans, listener ${blocks} blocks"
