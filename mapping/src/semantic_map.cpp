@@ -77,7 +77,23 @@ BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::u
   std::vector<std::uint32_t> counts;
   // (block id, point index) pairs in point order.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  pairs.reserve(training.size() * 4);
+  pairs.reserve(training.size() * (params.method == Method::kCsm ? 1 : 16));
+  // Direct-mapped cache of block ids by the low two bits of each block coordinate: a point's
+  // support spans at most 3 blocks per axis and neighbouring points share blocks, so most
+  // lookups skip the hash table. Ids come from the table either way, so results are unchanged.
+  struct CacheEntry {
+    BlockIndex block{0, 0, 0};
+    std::uint32_t id = VoxelHashMap::kNone;
+  };
+  std::array<CacheEntry, 64> cache{};
+  const auto block_id = [&](const BlockIndex& b) {
+    CacheEntry& e =
+        cache[static_cast<std::size_t>((b.x & 3) | ((b.y & 3) << 2) | ((b.z & 3) << 4))];
+    if (e.id != VoxelHashMap::kNone && e.block == b) return e.id;
+    e.block = b;
+    e.id = ids.insert(b);
+    return e.id;
+  };
   for (std::size_t i = 0; i < training.size(); ++i) {
     if (!usable[i]) continue;
     const CellBox box = support_of(training.points[i], params);
@@ -87,7 +103,7 @@ BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::u
       for (std::int32_t by = floor_div(box.lo[1], n); by <= floor_div(box.hi[1], n); ++by) {
         for (std::int32_t bx = floor_div(box.lo[0], n); bx <= floor_div(box.hi[0], n); ++bx) {
           const BlockIndex b{bx, by, bz};
-          const std::uint32_t id = ids.insert(b);
+          const std::uint32_t id = block_id(b);
           if (id == groups.blocks.size()) {
             groups.blocks.push_back(b);
             counts.push_back(0);
