@@ -70,7 +70,7 @@ struct BlockGroups {
 
 BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::uint8_t>& usable,
                            const MapParams& params) {
-  const std::int32_t n = params.cells_per_side();
+  const std::int32_t shift = params.block_depth - 1;  // n = 2^shift cells per side
   VoxelHashMap ids(training.size() / 4 + 16);
   BlockGroups groups;
   groups.boxes.resize(training.size(), CellBox{{0, 0, 0}, {-1, -1, -1}});
@@ -99,9 +99,15 @@ BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::u
     const CellBox box = support_of(training.points[i], params);
     groups.boxes[i] = box;
     if (empty(box)) continue;
-    for (std::int32_t bz = floor_div(box.lo[2], n); bz <= floor_div(box.hi[2], n); ++bz) {
-      for (std::int32_t by = floor_div(box.lo[1], n); by <= floor_div(box.hi[1], n); ++by) {
-        for (std::int32_t bx = floor_div(box.lo[0], n); bx <= floor_div(box.hi[0], n); ++bx) {
+    // n is a power of two, so an arithmetic shift is floor division.
+    std::array<std::int32_t, 3> blo{}, bhi{};
+    for (int a = 0; a < 3; ++a) {
+      blo[a] = box.lo[a] >> shift;
+      bhi[a] = box.hi[a] >> shift;
+    }
+    for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) {
+      for (std::int32_t by = blo[1]; by <= bhi[1]; ++by) {
+        for (std::int32_t bx = blo[0]; bx <= bhi[0]; ++bx) {
           const BlockIndex b{bx, by, bz};
           const std::uint32_t id = block_id(b);
           if (id == groups.blocks.size()) {
