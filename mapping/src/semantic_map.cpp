@@ -187,7 +187,7 @@ void smooth_point(Block& block, const CellBox& box, const std::array<const float
       while (x_hi >= x_lo && d2[0][x_hi - box.lo[0]] >= rest) --x_hi;
       if (x_lo > x_hi) continue;
       for (std::int32_t x = x_lo; x <= x_hi; ++x) {
-        const float w = kernel(dyz2 + d2[0][x - box.lo[0]]);
+        const float w = kernel.inside(dyz2 + d2[0][x - box.lo[0]]);
         float* alpha = column + static_cast<std::size_t>(row + x) * k;
         if constexpr (kSoft) {
           for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
