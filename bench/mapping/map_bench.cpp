@@ -165,6 +165,7 @@ void lidar_figures(int scans) {
 int main(int argc, char** argv) {
   std::string mode = argc > 1 ? argv[1] : "all";
   if (mode == "toy" || mode == "all") toy_figures(5);
+  if (mode == "toy1") toy_figures(1);  // one repetition, for callgrind
   if (mode == "lidar" || mode == "all") lidar_figures(100);
   if (mode == "lidar10") lidar_figures(10);
   return 0;

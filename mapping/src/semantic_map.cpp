@@ -66,28 +66,70 @@ struct BlockGroups {
   std::vector<std::uint32_t> offsets;  // blocks.size() + 1
   std::vector<std::uint32_t> points;
   std::vector<CellBox> boxes;  // support of every training point (empty if unusable)
+  // S-BKI: squared distances from each point to the cell centres of its support box along
+  // x, then y, then z (box widths), starting at distance_offsets[i]; computed once per point
+  // instead of once per (point, block).
+  std::vector<float> distances;
+  std::vector<std::uint32_t> distance_offsets;
 };
 
 BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::uint8_t>& usable,
                            const MapParams& params) {
-  const std::int32_t n = params.cells_per_side();
+  const std::int32_t shift = params.block_depth - 1;  // n = 2^shift cells per side
   VoxelHashMap ids(training.size() / 4 + 16);
   BlockGroups groups;
   groups.boxes.resize(training.size(), CellBox{{0, 0, 0}, {-1, -1, -1}});
+  if (params.method != Method::kCsm) {
+    groups.distance_offsets.assign(training.size(), 0);
+    const auto width = static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 2;
+    groups.distances.reserve(training.size() * 3 * width);
+  }
   std::vector<std::uint32_t> counts;
   // (block id, point index) pairs in point order.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  pairs.reserve(training.size() * 4);
+  pairs.reserve(training.size() * (params.method == Method::kCsm ? 1 : 16));
+  // Direct-mapped cache of block ids by the low two bits of each block coordinate: a point's
+  // support spans at most 3 blocks per axis and neighbouring points share blocks, so most
+  // lookups skip the hash table. Ids come from the table either way, so results are unchanged.
+  struct CacheEntry {
+    BlockIndex block{0, 0, 0};
+    std::uint32_t id = VoxelHashMap::kNone;
+  };
+  std::array<CacheEntry, 64> cache{};
+  const auto block_id = [&](const BlockIndex& b) {
+    CacheEntry& e =
+        cache[static_cast<std::size_t>((b.x & 3) | ((b.y & 3) << 2) | ((b.z & 3) << 4))];
+    if (e.id != VoxelHashMap::kNone && e.block == b) return e.id;
+    e.block = b;
+    e.id = ids.insert(b);
+    return e.id;
+  };
   for (std::size_t i = 0; i < training.size(); ++i) {
     if (!usable[i]) continue;
     const CellBox box = support_of(training.points[i], params);
     groups.boxes[i] = box;
     if (empty(box)) continue;
-    for (std::int32_t bz = floor_div(box.lo[2], n); bz <= floor_div(box.hi[2], n); ++bz) {
-      for (std::int32_t by = floor_div(box.lo[1], n); by <= floor_div(box.hi[1], n); ++by) {
-        for (std::int32_t bx = floor_div(box.lo[0], n); bx <= floor_div(box.hi[0], n); ++bx) {
+    if (params.method != Method::kCsm) {
+      groups.distance_offsets[i] = static_cast<std::uint32_t>(groups.distances.size());
+      for (int a = 0; a < 3; ++a) {
+        for (std::int32_t c = box.lo[a]; c <= box.hi[a]; ++c) {
+          const float d =
+              (static_cast<float>(c) + 0.5f) * params.resolution - training.points[i][a];
+          groups.distances.push_back(d * d);
+        }
+      }
+    }
+    // n is a power of two, so an arithmetic shift is floor division.
+    std::array<std::int32_t, 3> blo{}, bhi{};
+    for (int a = 0; a < 3; ++a) {
+      blo[a] = box.lo[a] >> shift;
+      bhi[a] = box.hi[a] >> shift;
+    }
+    for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) {
+      for (std::int32_t by = blo[1]; by <= bhi[1]; ++by) {
+        for (std::int32_t bx = blo[0]; bx <= bhi[0]; ++bx) {
           const BlockIndex b{bx, by, bz};
-          const std::uint32_t id = ids.insert(b);
+          const std::uint32_t id = block_id(b);
           if (id == groups.blocks.size()) {
             groups.blocks.push_back(b);
             counts.push_back(0);
@@ -108,15 +150,6 @@ BlockGroups group_by_block(const TrainingSet& training, const std::vector<std::u
   return groups;
 }
 
-// Squared distances from a coordinate to the cell centres lo..hi (local) along one axis.
-void axis_distances(float coordinate, std::int32_t first_global, std::int32_t lo, std::int32_t hi,
-                    float res, float* out) {
-  for (std::int32_t c = lo; c <= hi; ++c) {
-    const float d = (static_cast<float>(first_global + c) + 0.5f) * res - coordinate;
-    out[c] = d * d;
-  }
-}
-
 // Adds 1 * y_i to the cell containing training point i (S-CSM).
 void count_point(Block& block, int cell, const TrainingSet& training, std::size_t i) {
   const std::size_t k = static_cast<std::size_t>(training.num_classes);
@@ -131,10 +164,10 @@ void count_point(Block& block, int cell, const TrainingSet& training, std::size_
 }
 
 // Adds k(d) y_i to every cell of `box` (block-local, inclusive) within ell of point i.
-// `d2` holds the squared per-axis distances to the cell centres. Hard labels touch one float
-// per cell, hence the separate instantiation.
+// `d2[a][c - box.lo[a]]` is the squared distance along axis a to the centres of local cell c.
+// Hard labels touch one float per cell, hence the separate instantiation.
 template <bool kSoft>
-void smooth_point(Block& block, const CellBox& box, const std::array<std::array<float, 32>, 3>& d2,
+void smooth_point(Block& block, const CellBox& box, const std::array<const float*, 3>& d2,
                   const TrainingSet& training, std::size_t i, const KernelTable& kernel) {
   const std::size_t k = static_cast<std::size_t>(training.num_classes);
   const float ell2 = kernel.ell_squared();
@@ -143,18 +176,18 @@ void smooth_point(Block& block, const CellBox& box, const std::array<std::array<
   float* column = block.cell_evidence_mutable(0) + (kSoft ? 0 : training.labels[i]);
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
     for (std::int32_t yy = box.lo[1]; yy <= box.hi[1]; ++yy) {
-      const float dyz2 = d2[2][z] + d2[1][yy];
+      const float dyz2 = d2[2][z - box.lo[2]] + d2[1][yy - box.lo[1]];
       if (dyz2 >= ell2) continue;
       // A row of n <= 32 cells starts at a multiple of n, so it lies in one 64-bit word.
       const int row = block.cell_of(0, yy, z);
       // Trim the row to the sphere; distances along x are convex, so both ends suffice.
       const float rest = ell2 - dyz2;
       std::int32_t x_lo = box.lo[0], x_hi = box.hi[0];
-      while (x_lo <= x_hi && d2[0][x_lo] >= rest) ++x_lo;
-      while (x_hi >= x_lo && d2[0][x_hi] >= rest) --x_hi;
+      while (x_lo <= x_hi && d2[0][x_lo - box.lo[0]] >= rest) ++x_lo;
+      while (x_hi >= x_lo && d2[0][x_hi - box.lo[0]] >= rest) --x_hi;
       if (x_lo > x_hi) continue;
       for (std::int32_t x = x_lo; x <= x_hi; ++x) {
-        const float w = kernel(dyz2 + d2[0][x]);
+        const float w = kernel.inside(dyz2 + d2[0][x - box.lo[0]]);
         float* alpha = column + static_cast<std::size_t>(row + x) * k;
         if constexpr (kSoft) {
           for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
@@ -174,9 +207,9 @@ void update_block(Block& block, const BlockIndex& index, std::span<const std::ui
                   const KernelTable& kernel) {
   const std::int32_t n = params.cells_per_side();
   const std::array<std::int32_t, 3> base{index.x * n, index.y * n, index.z * n};
-  std::array<std::array<float, 32>, 3> d2{};  // n <= 32 for block_depth <= 6
   for (const std::uint32_t i : points) {
-    CellBox box = groups.boxes[i];
+    const CellBox& support = groups.boxes[i];
+    CellBox box = support;
     for (int a = 0; a < 3; ++a) {
       box.lo[a] = std::max(box.lo[a], base[a]) - base[a];
       box.hi[a] = std::min(box.hi[a], base[a] + n - 1) - base[a];
@@ -185,9 +218,11 @@ void update_block(Block& block, const BlockIndex& index, std::span<const std::ui
       count_point(block, block.cell_of(box.lo[0], box.lo[1], box.lo[2]), training, i);
       continue;
     }
-    const Eigen::Vector3f& p = training.points[i];
+    const float* first = groups.distances.data() + groups.distance_offsets[i];
+    std::array<const float*, 3> d2{};
     for (int a = 0; a < 3; ++a) {
-      axis_distances(p[a], base[a], box.lo[a], box.hi[a], params.resolution, d2[a].data());
+      d2[a] = first + (base[a] + box.lo[a] - support.lo[a]);
+      first += support.hi[a] - support.lo[a] + 1;
     }
     if (training.labels[i] >= 0) {
       smooth_point<false>(block, box, d2, training, i, kernel);

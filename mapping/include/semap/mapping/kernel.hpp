@@ -40,6 +40,14 @@ class KernelTable {
     return lines_[2 * i] + lines_[2 * i + 1] * s;
   }
 
+  // Same value as operator(), without the clamp, for d2 known to be below ell^2 up to
+  // rounding: there d2 / step stays below intervals + 1, whose entry (0, 0) gives exactly 0.
+  float inside(float d2) const {
+    const float s = d2 * inv_step_;
+    const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
+    return lines_[2 * i] + lines_[2 * i + 1] * s;
+  }
+
   float ell_squared() const { return ell2_; }
 
  private:
