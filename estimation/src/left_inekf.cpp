@@ -61,6 +61,40 @@ Eigen::Matrix<double, R, 9> times_phi_top_transposed(const LeftInekfTransition& 
   return out;
 }
 
+// Upper block triangle of Y^T Phi_top^T (symmetric, = Phi_top P Phi_top^T) into p's top-left
+// 9x9: block column j only for rows 0..3j+2, computed on the even-height copy y_t of Y^T.
+void upper_phi_y(const LeftInekfTransition& b, const Eigen::Matrix<double, 10, 15>& y_t,
+                 Matrix15& p) {
+  {
+    Eigen::Matrix<double, 4, 3> o;
+    const auto y = y_t.topRows<4>();
+    set_product(o, y.middleCols<3>(kRot), b.omega);
+    add_product(o, y.middleCols<3>(kGyroBias), b.f14);
+    p.block<3, 3>(0, 0) = o.topRows<3>();
+  }
+  {
+    Eigen::Matrix<double, 6, 3> o;
+    const auto y = y_t.topRows<6>();
+    set_product(o, y.middleCols<3>(kRot), b.f21);
+    add_product(o, y.middleCols<3>(kVel), b.omega);
+    add_product(o, y.middleCols<3>(kGyroBias), b.f24);
+    add_product(o, y.middleCols<3>(kAccelBias), b.f25);
+    p.block<6, 3>(0, 3) = o;
+  }
+  {
+    Eigen::Matrix<double, 10, 3> o;
+    const Eigen::Matrix<double, 10, 3> y23 =
+        b.dt * y_t.middleCols<3>(kVel) + y_t.middleCols<3>(kPos);
+    set_product(o, y_t.middleCols<3>(kRot), b.f31);
+    add_product(o, y23, b.omega);
+    add_product(o, y_t.middleCols<3>(kGyroBias), b.f34);
+    add_product(o, y_t.middleCols<3>(kAccelBias), b.f35);
+    p.block<9, 3>(0, 6) = o.topRows<9>();
+  }
+  p.topLeftCorner<9, 9>().triangularView<Eigen::StrictlyLower>() =
+      p.topLeftCorner<9, 9>().transpose();
+}
+
 }  // namespace
 
 LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector3d& a, double dt) {
@@ -156,8 +190,7 @@ void LeftInekf::apply_transition(const LeftInekfTransition& phi) {
   Eigen::Matrix<double, 10, 15> y_t;
   y_t.topRows<9>() = y.topRows<15>().transpose();
   y_t.row(9).setZero();
-  const Eigen::Matrix<double, 10, 9> tl = times_phi_top_transposed<10>(phi, y_t);
-  p_.topLeftCorner<9, 9>() = 0.5 * (tl.topRows<9>() + tl.topRows<9>().transpose());
+  upper_phi_y(phi, y_t, p_);
   p_.bottomLeftCorner<6, 9>() = y.middleRows<6>(9);
   p_.topRightCorner<9, 6>() = y.middleRows<6>(9).transpose();
 }
