@@ -1,6 +1,7 @@
 #include "semap/estimation/kalman_update.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 
 namespace semap::estimation {
 
@@ -21,10 +22,16 @@ Matrix15x3 times_h_transposed(const Matrix15& x, const Matrix3x15& h) {
   return out;
 }
 
-// out += a b^T for 15 x 3 factors.
-void add_outer(Matrix15& out, const Matrix15x3& a, const Matrix15x3& b) {
-  for (int c = 0; c < 15; ++c) {
-    out.col(c) += a.col(0) * b(c, 0) + a.col(1) * b(c, 1) + a.col(2) * b(c, 2);
+// Block column J of P += M K^T - K (P H^T)^T, rows 0..3J+2 only (the upper triangle and the
+// diagonal block), as column AXPYs of fixed height.
+template <int J>
+void update_upper(Matrix15& p, const Matrix15x3& m, const Matrix15x3& k, const Matrix15x3& pht) {
+  constexpr int kRows = 3 * J + 3;
+  for (int c = 3 * J; c < 3 * J + 3; ++c) {
+    p.col(c).head<kRows>() +=
+        m.col(0).head<kRows>() * k(c, 0) + m.col(1).head<kRows>() * k(c, 1) +
+        m.col(2).head<kRows>() * k(c, 2) - k.col(0).head<kRows>() * pht(c, 0) -
+        k.col(1).head<kRows>() * pht(c, 1) - k.col(2).head<kRows>() * pht(c, 2);
   }
 }
 }  // namespace
@@ -36,19 +43,34 @@ KalmanUpdate joseph_update(Matrix15& covariance, const Eigen::Vector3d& innovati
   const Eigen::Matrix3d s = h.lazyProduct(pht) + noise;
   const Eigen::LLT<Eigen::Matrix3d> llt(s);
   if (llt.info() != Eigen::Success) return out;
-  out.mahalanobis2 = innovation.dot(llt.solve(innovation));
+  // S is a well-conditioned 3x3 (P block plus measurement noise): its closed-form inverse is
+  // far cheaper than an LLT solve with 15 right-hand sides (Eigen's generic triangular path).
+  Eigen::Matrix3d s_inv = s.inverse();
+  s_inv = 0.5 * (s_inv + s_inv.transpose()).eval();
+  out.mahalanobis2 = innovation.dot(s_inv * innovation);
   if (!(out.mahalanobis2 < gate2)) return out;  // also rejects NaN
   out.accepted = true;
-  // K = P H^T S^-1, with S symmetric: K^T = S^-1 (P H^T)^T.
-  const Eigen::Matrix<double, 15, 3> k = llt.solve(pht.transpose()).transpose();
+  // K = P H^T S^-1, as column AXPYs.
+  Matrix15x3 k;
+  for (int c = 0; c < 3; ++c) {
+    k.col(c) = pht.col(0) * s_inv(0, c) + pht.col(1) * s_inv(1, c) + pht.col(2) * s_inv(2, c);
+  }
   out.delta.noalias() = k * innovation;
-  Matrix15 ap = covariance;
-  add_outer(ap, -k, pht);  // (I - K H) P, using H P = (P H^T)^T
-  Eigen::Matrix<double, 15, 3> m = k * noise;
-  m -= times_h_transposed(ap, h);  // K N - A P H^T
-  covariance = ap;
-  add_outer(covariance, m, k);  // A P A^T + K N K^T
-  covariance = 0.5 * (covariance + covariance.transpose()).eval();
+  // Joseph form A P A^T + K N K^T with A = I - K H, expanded through the rank-3 structure:
+  // A P = P - K (P H^T)^T and A P H^T = P H^T - K S_p with S_p = H P H^T, so
+  // P+ = P - K (P H^T)^T + M K^T with M = K N - A P H^T = K S - P H^T (zero up to rounding for
+  // the optimal gain, which is what keeps the form robust). Updated in place.
+  Matrix15x3 m = -pht;
+  for (int c = 0; c < 3; ++c) {
+    m.col(c) += k.col(0) * s(0, c) + k.col(1) * s(1, c) + k.col(2) * s(2, c);
+  }
+  // Only the upper triangle (block column j, rows 0..3j+2) is formed, then mirrored.
+  update_upper<0>(covariance, m, k, pht);
+  update_upper<1>(covariance, m, k, pht);
+  update_upper<2>(covariance, m, k, pht);
+  update_upper<3>(covariance, m, k, pht);
+  update_upper<4>(covariance, m, k, pht);
+  covariance.triangularView<Eigen::StrictlyLower>() = covariance.transpose();
   return out;
 }
 

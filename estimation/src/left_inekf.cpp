@@ -61,6 +61,40 @@ Eigen::Matrix<double, R, 9> times_phi_top_transposed(const LeftInekfTransition& 
   return out;
 }
 
+// Upper block triangle of Y^T Phi_top^T (symmetric, = Phi_top P Phi_top^T) into p's top-left
+// 9x9: block column j only for rows 0..3j+2, computed on the even-height copy y_t of Y^T.
+void upper_phi_y(const LeftInekfTransition& b, const Eigen::Matrix<double, 10, 15>& y_t,
+                 Matrix15& p) {
+  {
+    Eigen::Matrix<double, 4, 3> o;
+    const auto y = y_t.topRows<4>();
+    set_product(o, y.middleCols<3>(kRot), b.omega);
+    add_product(o, y.middleCols<3>(kGyroBias), b.f14);
+    p.block<3, 3>(0, 0) = o.topRows<3>();
+  }
+  {
+    Eigen::Matrix<double, 6, 3> o;
+    const auto y = y_t.topRows<6>();
+    set_product(o, y.middleCols<3>(kRot), b.f21);
+    add_product(o, y.middleCols<3>(kVel), b.omega);
+    add_product(o, y.middleCols<3>(kGyroBias), b.f24);
+    add_product(o, y.middleCols<3>(kAccelBias), b.f25);
+    p.block<6, 3>(0, 3) = o;
+  }
+  {
+    Eigen::Matrix<double, 10, 3> o;
+    const Eigen::Matrix<double, 10, 3> y23 =
+        b.dt * y_t.middleCols<3>(kVel) + y_t.middleCols<3>(kPos);
+    set_product(o, y_t.middleCols<3>(kRot), b.f31);
+    add_product(o, y23, b.omega);
+    add_product(o, y_t.middleCols<3>(kGyroBias), b.f34);
+    add_product(o, y_t.middleCols<3>(kAccelBias), b.f35);
+    p.block<9, 3>(0, 6) = o.topRows<9>();
+  }
+  p.topLeftCorner<9, 9>().triangularView<Eigen::StrictlyLower>() =
+      p.topLeftCorner<9, 9>().transpose();
+}
+
 }  // namespace
 
 LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector3d& a, double dt) {
@@ -69,15 +103,17 @@ LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector
   const Vector3d phi = w * dt;
   const auto c = gamma_coefficients(phi.norm());
   const Matrix3d k = skew(phi);
-  const Matrix3d k2 = k * k;
+  // K^2 = phi phi^T - |phi|^2 I.
+  Matrix3d k2 = phi * phi.transpose();
+  k2.diagonal().array() -= phi.squaredNorm();
   const Matrix3d g1 = Matrix3d::Identity() + c.a1 * k + c.b1 * k2;
   const Matrix3d g2 = 0.5 * Matrix3d::Identity() + c.a2 * k + c.b2 * k2;
   // Gamma0^T = I - a0 K + b0 K^2 (K^T = -K).
   b.omega = Matrix3d::Identity() - c.a0 * k + c.b0 * k2;
-  const Vector3d u1 = g1 * a * dt;
-  const Vector3d u2 = g2 * a * (dt * dt);
-  b.f21.noalias() = -b.omega * skew(u1);
-  b.f31.noalias() = -b.omega * skew(u2);
+  b.u1.noalias() = g1 * (a * dt);
+  b.u2.noalias() = g2 * (a * (dt * dt));
+  b.f21.noalias() = -b.omega * skew(b.u1);
+  b.f31.noalias() = -b.omega * skew(b.u2);
   b.f14 = -dt * g1.transpose();  // omega Gamma1(phi) = Gamma1(-phi) = Gamma1(phi)^T
   b.f25 = b.f14;
   b.f35.noalias() = -(dt * dt) * b.omega * g2;
@@ -91,8 +127,9 @@ LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector
     const auto cs = gamma_coefficients(ps.norm());
     const Vector3d pa = ps.cross(a);
     const Vector3d rot_a = a + cs.a0 * pa + cs.b0 * ps.cross(pa);
-    const Matrix3d ks = skew(ps);
-    const Matrix3d sg1 = s * (Matrix3d::Identity() + cs.a1 * ks + cs.b1 * ks * ks);
+    // s Gamma1(w s) = s (I + a1 [ps]x + b1 (ps ps^T - |ps|^2 I)).
+    Matrix3d sg1 = (s * cs.a1) * skew(ps) + (s * cs.b1) * (ps * ps.transpose());
+    sg1.diagonal().array() += s * (1.0 - cs.b1 * ps.squaredNorm());
     const Matrix3d g = skew(rot_a) * sg1;
     i24 += (kWeights[n] * dt) * g;
     i34 += (kWeights[n] * dt * (dt - s)) * g;
@@ -156,8 +193,7 @@ void LeftInekf::apply_transition(const LeftInekfTransition& phi) {
   Eigen::Matrix<double, 10, 15> y_t;
   y_t.topRows<9>() = y.topRows<15>().transpose();
   y_t.row(9).setZero();
-  const Eigen::Matrix<double, 10, 9> tl = times_phi_top_transposed<10>(phi, y_t);
-  p_.topLeftCorner<9, 9>() = 0.5 * (tl.topRows<9>() + tl.topRows<9>().transpose());
+  upper_phi_y(phi, y_t, p_);
   p_.bottomLeftCorner<6, 9>() = y.middleRows<6>(9);
   p_.topRightCorner<9, 6>() = y.middleRows<6>(9).transpose();
 }
@@ -165,24 +201,15 @@ void LeftInekf::apply_transition(const LeftInekfTransition& phi) {
 void LeftInekf::propagate(const Vector3d& gyro, const Vector3d& accel, double dt) {
   const Vector3d w = gyro - bg_;
   const Vector3d a = accel - ba_;
-  const Vector3d phi = w * dt;
-  const auto c = gamma_coefficients(phi.norm());
-  const Matrix3d k = skew(phi);
-  const Matrix3d k2 = k * k;
-  const Matrix3d g0 = Matrix3d::Identity() + c.a0 * k + c.b0 * k2;
-  const Vector3d ka = k * a;
-  const Vector3d k2a = k * ka;
-  const Vector3d u1 = (a + c.a1 * ka + c.b1 * k2a) * dt;
-  const Vector3d u2 = (0.5 * a + c.a2 * ka + c.b2 * k2a) * (dt * dt);
-
   // P- = Phi (P + Q dt) Phi^T
   p_.diagonal() += q_diag_ * dt;
-  apply_transition(LeftInekfTransition::compute(w, a, dt));
+  const LeftInekfTransition t = LeftInekfTransition::compute(w, a, dt);
+  apply_transition(t);
 
   const Vector3d& g = params_.gravity;
-  p_pos_ += v_ * dt + r_ * u2 + (0.5 * dt * dt) * g;
-  v_ += r_ * u1 + dt * g;
-  r_ = r_ * g0;
+  p_pos_ += v_ * dt + r_ * t.u2 + (0.5 * dt * dt) * g;
+  v_ += r_ * t.u1 + dt * g;
+  r_ = r_ * t.omega.transpose();  // R Gamma0(w dt)
   if (++steps_since_normalise_ >= kNormaliseEvery) {
     r_ = Eigen::Quaterniond(r_).normalized().toRotationMatrix();
     steps_since_normalise_ = 0;

@@ -13,6 +13,7 @@ namespace semap::estimation {
 struct LeftInekfTransition {
   Eigen::Matrix3d omega;  // Gamma0(w dt)^T
   Eigen::Matrix3d f21, f31, f14, f24, f25, f34, f35;
+  Eigen::Vector3d u1, u2;  // Gamma1(w dt) a dt and Gamma2(w dt) a dt^2 (the state increments)
   double dt = 0.0;
 
   // The transition for bias-corrected rates w and accelerations a held over dt.
