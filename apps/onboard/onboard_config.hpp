@@ -76,7 +76,7 @@ struct OnboardConfig {
   CameraConfig camera;
   estimation::EstimatorConfig estimator;
   mapping::MapParams map;
-  std::string map_save_path;  // .smap written at exit when set
+  std::string map_save_path;       // .smap written at exit when set
   mapping::SourceId robot_id = 1;  // this robot's evidence layer in saved and merged maps
   int map_threads = 2;
   DdsConfig dds;
