@@ -17,6 +17,7 @@
 
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/drivers/serial_port.hpp"
 #include "semap/firmware_bridge/constant_turn_source.hpp"
 #include "semap/firmware_bridge/emulator.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
@@ -28,27 +29,6 @@ namespace fb = semap::firmware_bridge;
 std::atomic<bool> g_stop{false};
 
 void on_signal(int) { g_stop = true; }
-
-speed_t baud_constant(int baud) {
-  switch (baud) {
-    case 9600:
-      return B9600;
-    case 38400:
-      return B38400;
-    case 57600:
-      return B57600;
-    case 115200:
-      return B115200;
-    case 230400:
-      return B230400;
-    case 460800:
-      return B460800;
-    case 921600:
-      return B921600;
-    default:
-      throw std::runtime_error("unsupported --baud " + std::to_string(baud));
-  }
-}
 
 // The serial side: a pty we create (slave kept open so the master never sees EIO) or a device.
 struct SerialOutput {
@@ -63,7 +43,7 @@ struct SerialOutput {
 void open_serial(SerialOutput& out, bool use_pty, const std::string& device, int baud) {
   termios raw{};
   cfmakeraw(&raw);
-  cfsetspeed(&raw, baud_constant(baud));
+  cfsetspeed(&raw, semap::drivers::baud_constant(baud));
   if (use_pty) {
     char name[128] = {};
     if (::openpty(&out.fd, &out.pty_slave, name, &raw, nullptr) != 0) {
