@@ -2,6 +2,46 @@
 
 set(SEMAP_WARNINGS -Wall -Wextra -Wpedantic -Werror)
 
+# The numeric libraries (estimation, mapping) may be compiled for a newer x86-64 level than
+# the rest, e.g. x86-64-v3 (AVX2 + FMA) on the robot computer that builds them. Eigen's object
+# layout must not depend on that, so alignment is capped at 16 bytes for every target: AVX code
+# then uses unaligned 32-byte loads, which cost nothing extra on CPUs that have AVX2.
+set(SEMAP_SIMD_ARCH "" CACHE STRING
+    "-march for estimation and mapping (e.g. x86-64-v3); empty keeps the compiler default")
+add_compile_definitions(EIGEN_MAX_ALIGN_BYTES=16)
+if(SEMAP_SIMD_ARCH)
+  # Only when this machine can run it: a binary built here for a level the CPU lacks would
+  # die with SIGILL in the tests.
+  include(CheckCXXSourceRuns)
+  set(CMAKE_REQUIRED_FLAGS "-march=${SEMAP_SIMD_ARCH}")
+  check_cxx_source_runs([[
+    int main() {
+      __builtin_cpu_init();
+    #ifdef __AVX2__
+      if (!__builtin_cpu_supports("avx2")) return 1;
+    #endif
+    #ifdef __FMA__
+      if (!__builtin_cpu_supports("fma")) return 1;
+    #endif
+    #ifdef __AVX512F__
+      if (!__builtin_cpu_supports("avx512f")) return 1;
+    #endif
+      return 0;
+    }]] SEMAP_SIMD_ARCH_RUNS_${SEMAP_SIMD_ARCH})
+  unset(CMAKE_REQUIRED_FLAGS)
+  if(NOT SEMAP_SIMD_ARCH_RUNS_${SEMAP_SIMD_ARCH})
+    message(WARNING "SEMAP_SIMD_ARCH=${SEMAP_SIMD_ARCH} does not run on this CPU: building portable code")
+    set(SEMAP_SIMD_ARCH "")
+  endif()
+endif()
+
+# semap_simd_tuned(TARGET): compiles TARGET's own sources for SEMAP_SIMD_ARCH.
+function(semap_simd_tuned target)
+  if(SEMAP_SIMD_ARCH)
+    target_compile_options(${target} PRIVATE -march=${SEMAP_SIMD_ARCH})
+  endif()
+endfunction()
+
 foreach(lib common firmware_bridge drivers estimation mapping dds_idl)
   if(SEMAP_ONLY STREQUAL "" OR lib IN_LIST SEMAP_ONLY)
     set(semap_wants_${lib} TRUE)

@@ -56,7 +56,7 @@ void propagate(benchmark::State& state) {
   for (auto _ : state) {
     f.propagate(in.gyro[i], in.accel[i], 0.01);
     i = (i + 1) % kInputs;
-    benchmark::DoNotOptimize(f.covariance().data());
+    benchmark::DoNotOptimize(f);
   }
 }
 
@@ -79,17 +79,19 @@ void gnss_correction(benchmark::State& state) {
 
 void transition_only(benchmark::State& state) {
   const Inputs in;
+  const FilterParams params;
+  const NavState s = start_state();
   std::size_t i = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(
-        semap::estimation::LeftInekfTransition::compute(in.gyro[i], in.accel[i], 0.01));
+    benchmark::DoNotOptimize(semap::estimation::InekfImuStep::compute(
+        s.rotation, s.velocity, s.position, in.gyro[i], in.accel[i], 0.01, params.gravity));
     i = (i + 1) % kInputs;
   }
 }
 
 BENCHMARK(propagate<semap::estimation::LeftInekf>)->Name("inekf/propagate");
 BENCHMARK(gnss_correction<semap::estimation::LeftInekf>)->Name("inekf/gnss_correction");
-BENCHMARK(transition_only)->Name("inekf/transition_phi_only");
+BENCHMARK(transition_only)->Name("inekf/imu_step_only");
 BENCHMARK(propagate<semap::estimation::QuaternionEskf>)->Name("eskf/propagate");
 BENCHMARK(gnss_correction<semap::estimation::QuaternionEskf>)->Name("eskf/gnss_correction");
 

@@ -1,8 +1,6 @@
 #include "semap/estimation/left_inekf.hpp"
 
 #include <Eigen/Geometry>
-#include <array>
-#include <cmath>
 
 #include "semap/estimation/kalman_update.hpp"
 #include "semap/estimation/so3.hpp"
@@ -13,147 +11,53 @@ namespace {
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
+using PaddedBlock9 = LeftInekf::PaddedBlock9;
+using PaddedBlock6 = LeftInekf::PaddedBlock6;
 
 // Orthonormality drifts by ~1e-16 per step; re-projecting every few hundred steps is enough.
 constexpr unsigned kNormaliseEvery = 256;
 
-// 3-point Gauss-Legendre nodes and weights on [0, 1].
-constexpr std::array<double, 3> kNodes = {0.1127016653792583, 0.5, 0.8872983346207417};
-constexpr std::array<double, 3> kWeights = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+// Distance from the covariance origin beyond which it is moved to the robot (see header).
+constexpr double kMaxOriginDistance = 100.0;
 
-// out (=|+=) x m^T for R x 3 column blocks, written as column AXPYs: each is a whole-column
-// vector operation that Eigen vectorises (the generic small-product path stays scalar here).
-template <typename Out, typename In>
-void set_product(Out&& out, const In& x, const Eigen::Matrix3d& m) {
-  for (int c = 0; c < 3; ++c) {
-    out.col(c) = x.col(0) * m(c, 0) + x.col(1) * m(c, 1) + x.col(2) * m(c, 2);
-  }
-}
-template <typename Out, typename In>
-void add_product(Out&& out, const In& x, const Eigen::Matrix3d& m) {
-  for (int c = 0; c < 3; ++c) {
-    out.col(c) += x.col(0) * m(c, 0) + x.col(1) * m(c, 1) + x.col(2) * m(c, 2);
+// Left-multiplies the rot/vel/pos row blocks of m by the gravity shear
+// F = [[I, 0, 0], [[g]x dt, I, 0], [[g]x dt^2/2, I dt, I]].
+template <typename M>
+void shear_rows(M& m, const Vector3d& g, double dt) {
+  for (int c = 0; c < m.cols(); ++c) {
+    const Vector3d gr = dt * g.cross(Vector3d(m.template block<3, 1>(kRot, c)));
+    m.template block<3, 1>(kPos, c) += dt * m.template block<3, 1>(kVel, c) + (0.5 * dt) * gr;
+    m.template block<3, 1>(kVel, c) += gr;
   }
 }
 
-// X Phi_top^T for X with 15 columns (R rows): block column i of the result is
-// sum_j X[:, j] Phi_ij^T. R is kept even so every column is whole SIMD packets.
-template <int R>
-Eigen::Matrix<double, R, 9> times_phi_top_transposed(const LeftInekfTransition& b,
-                                                     const Eigen::Matrix<double, R, 15>& x) {
-  Eigen::Matrix<double, R, 9> out;
-  const auto x1 = x.template middleCols<3>(kRot);
-  const auto x2 = x.template middleCols<3>(kVel);
-  const auto x3 = x.template middleCols<3>(kPos);
-  const auto x4 = x.template middleCols<3>(kGyroBias);
-  const auto x5 = x.template middleCols<3>(kAccelBias);
-  const Eigen::Matrix<double, R, 3> x23 = b.dt * x2 + x3;
-  set_product(out.template middleCols<3>(0), x1, b.omega);
-  add_product(out.template middleCols<3>(0), x4, b.f14);
-  set_product(out.template middleCols<3>(3), x1, b.f21);
-  add_product(out.template middleCols<3>(3), x2, b.omega);
-  add_product(out.template middleCols<3>(3), x4, b.f24);
-  add_product(out.template middleCols<3>(3), x5, b.f25);
-  set_product(out.template middleCols<3>(6), x1, b.f31);
-  add_product(out.template middleCols<3>(6), x23, b.omega);
-  add_product(out.template middleCols<3>(6), x4, b.f34);
-  add_product(out.template middleCols<3>(6), x5, b.f35);
-  return out;
+// Right-multiplies the 9 columns of m by F^T, as whole-column AXPYs ([g]x has a zero
+// diagonal, so each column takes two rotation columns).
+void shear_columns(PaddedBlock9& m, const Vector3d& g, double dt) {
+  const Matrix3d d1 = dt * skew(g);
+  const Matrix3d d2 = (0.5 * dt) * d1;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const int k = (i + 2) % 3;
+    m.col(kPos + i) +=
+        dt * m.col(kVel + i) + d2(i, j) * m.col(kRot + j) + d2(i, k) * m.col(kRot + k);
+    m.col(kVel + i) += d1(i, j) * m.col(kRot + j) + d1(i, k) * m.col(kRot + k);
+  }
 }
 
-// Upper block triangle of Y^T Phi_top^T (symmetric, = Phi_top P Phi_top^T) into p's top-left
-// 9x9: block column j only for rows 0..3j+2, computed on the even-height copy y_t of Y^T.
-void upper_phi_y(const LeftInekfTransition& b, const Eigen::Matrix<double, 10, 15>& y_t,
-                 Matrix15& p) {
-  {
-    Eigen::Matrix<double, 4, 3> o;
-    const auto y = y_t.topRows<4>();
-    set_product(o, y.middleCols<3>(kRot), b.omega);
-    add_product(o, y.middleCols<3>(kGyroBias), b.f14);
-    p.block<3, 3>(0, 0) = o.topRows<3>();
+// Left-multiplies the rot/vel/pos row blocks of m by Ad_E for E = (e, dv, dp):
+// [[e, 0, 0], [[dv]x e, e, 0], [[dp]x e, 0, e]].
+template <typename M>
+void apply_adjoint(M& m, const Matrix3d& e, const Vector3d& dv, const Vector3d& dp) {
+  for (int c = 0; c < m.cols(); ++c) {
+    const Vector3d rot = e * m.template block<3, 1>(kRot, c);
+    m.template block<3, 1>(kRot, c) = rot;
+    m.template block<3, 1>(kVel, c) = e * m.template block<3, 1>(kVel, c) + dv.cross(rot);
+    m.template block<3, 1>(kPos, c) = e * m.template block<3, 1>(kPos, c) + dp.cross(rot);
   }
-  {
-    Eigen::Matrix<double, 6, 3> o;
-    const auto y = y_t.topRows<6>();
-    set_product(o, y.middleCols<3>(kRot), b.f21);
-    add_product(o, y.middleCols<3>(kVel), b.omega);
-    add_product(o, y.middleCols<3>(kGyroBias), b.f24);
-    add_product(o, y.middleCols<3>(kAccelBias), b.f25);
-    p.block<6, 3>(0, 3) = o;
-  }
-  {
-    Eigen::Matrix<double, 10, 3> o;
-    const Eigen::Matrix<double, 10, 3> y23 =
-        b.dt * y_t.middleCols<3>(kVel) + y_t.middleCols<3>(kPos);
-    set_product(o, y_t.middleCols<3>(kRot), b.f31);
-    add_product(o, y23, b.omega);
-    add_product(o, y_t.middleCols<3>(kGyroBias), b.f34);
-    add_product(o, y_t.middleCols<3>(kAccelBias), b.f35);
-    p.block<9, 3>(0, 6) = o.topRows<9>();
-  }
-  p.topLeftCorner<9, 9>().triangularView<Eigen::StrictlyLower>() =
-      p.topLeftCorner<9, 9>().transpose();
 }
 
 }  // namespace
-
-LeftInekfTransition LeftInekfTransition::compute(const Vector3d& w, const Vector3d& a, double dt) {
-  LeftInekfTransition b;
-  b.dt = dt;
-  const Vector3d phi = w * dt;
-  const auto c = gamma_coefficients(phi.norm());
-  const Matrix3d k = skew(phi);
-  // K^2 = phi phi^T - |phi|^2 I.
-  Matrix3d k2 = phi * phi.transpose();
-  k2.diagonal().array() -= phi.squaredNorm();
-  const Matrix3d g1 = Matrix3d::Identity() + c.a1 * k + c.b1 * k2;
-  const Matrix3d g2 = 0.5 * Matrix3d::Identity() + c.a2 * k + c.b2 * k2;
-  // Gamma0^T = I - a0 K + b0 K^2 (K^T = -K).
-  b.omega = Matrix3d::Identity() - c.a0 * k + c.b0 * k2;
-  b.u1.noalias() = g1 * (a * dt);
-  b.u2.noalias() = g2 * (a * (dt * dt));
-  b.f21.noalias() = -b.omega * skew(b.u1);
-  b.f31.noalias() = -b.omega * skew(b.u2);
-  b.f14 = -dt * g1.transpose();  // omega Gamma1(phi) = Gamma1(-phi) = Gamma1(phi)^T
-  b.f25 = b.f14;
-  b.f35.noalias() = -(dt * dt) * b.omega * g2;
-  // Gyro-bias couplings: Phi_24 = omega int_0^dt [e^{W s} a]x s Gamma1(w s) ds and
-  // Phi_34 = omega int_0^dt (dt - s) [e^{W s} a]x s Gamma1(w s) ds.
-  Matrix3d i24 = Matrix3d::Zero();
-  Matrix3d i34 = Matrix3d::Zero();
-  for (std::size_t n = 0; n < kNodes.size(); ++n) {
-    const double s = kNodes[n] * dt;
-    const Vector3d ps = w * s;
-    const auto cs = gamma_coefficients(ps.norm());
-    const Vector3d pa = ps.cross(a);
-    const Vector3d rot_a = a + cs.a0 * pa + cs.b0 * ps.cross(pa);
-    // s Gamma1(w s) = s (I + a1 [ps]x + b1 (ps ps^T - |ps|^2 I)).
-    Matrix3d sg1 = (s * cs.a1) * skew(ps) + (s * cs.b1) * (ps * ps.transpose());
-    sg1.diagonal().array() += s * (1.0 - cs.b1 * ps.squaredNorm());
-    const Matrix3d g = skew(rot_a) * sg1;
-    i24 += (kWeights[n] * dt) * g;
-    i34 += (kWeights[n] * dt * (dt - s)) * g;
-  }
-  b.f24.noalias() = b.omega * i24;
-  b.f34.noalias() = b.omega * i34;
-  return b;
-}
-
-Matrix15 LeftInekfTransition::dense() const {
-  Matrix15 f = Matrix15::Identity();
-  f.block<3, 3>(kRot, kRot) = omega;
-  f.block<3, 3>(kVel, kVel) = omega;
-  f.block<3, 3>(kPos, kPos) = omega;
-  f.block<3, 3>(kPos, kVel) = dt * omega;
-  f.block<3, 3>(kVel, kRot) = f21;
-  f.block<3, 3>(kPos, kRot) = f31;
-  f.block<3, 3>(kRot, kGyroBias) = f14;
-  f.block<3, 3>(kVel, kGyroBias) = f24;
-  f.block<3, 3>(kVel, kAccelBias) = f25;
-  f.block<3, 3>(kPos, kGyroBias) = f34;
-  f.block<3, 3>(kPos, kAccelBias) = f35;
-  return f;
-}
 
 Eigen::Matrix<double, 15, 1> process_noise_diagonal(const ImuNoise& noise) {
   Eigen::Matrix<double, 15, 1> q;
@@ -177,75 +81,139 @@ void LeftInekf::reset(const NavState& state, const Matrix15& world_covariance) {
   // World-axis errors map to left-invariant ones through R^T on the three group blocks.
   Matrix15 t = Matrix15::Identity();
   for (int b = 0; b < 3; ++b) t.block<3, 3>(3 * b, 3 * b) = r_.transpose();
-  p_ = t * world_covariance * t.transpose();
+  origin_ = state.position;
+  const Matrix15 to_world = world_from_left(relative_state()) * t;
+  set_world_covariance(to_world * world_covariance * to_world.transpose());
   steps_since_normalise_ = 0;
 }
 
-void LeftInekf::apply_transition(const LeftInekfTransition& phi) {
-  // With Phi = [[F, G], [0, I]] (F, G: rows 0..8), P- = Phi P Phi^T has
-  //   top-right 9x6 = (P Phi_top^T)[9..14, :]^T and top-left 9x9 = Phi_top (P Phi_top^T),
-  // and an unchanged bias block. Both products are formed as X Phi_top^T, on copies padded
-  // to an even row count so that every column is whole SIMD packets.
-  Eigen::Matrix<double, 16, 15> padded;
-  padded.topRows<15>() = p_;
-  padded.row(15).setZero();
-  const Eigen::Matrix<double, 16, 9> y = times_phi_top_transposed<16>(phi, padded);
-  Eigen::Matrix<double, 10, 15> y_t;
-  y_t.topRows<9>() = y.topRows<15>().transpose();
-  y_t.row(9).setZero();
-  upper_phi_y(phi, y_t, p_);
-  p_.bottomLeftCorner<6, 9>() = y.middleRows<6>(9);
-  p_.topRightCorner<9, 6>() = y.middleRows<6>(9).transpose();
+void LeftInekf::add_process_noise(double dt) {
+  // P_w += Ad_X (Q dt) Ad_X^T for the isotropic blocks of Q, in closed form with
+  // [v]x [v]x^T = |v|^2 I - v v^T and [p]x [v]x^T = (p.v) I - v p^T.
+  const double qg = q_diag_(kRot) * dt;
+  const double qa = q_diag_(kVel) * dt;
+  const double qp = q_diag_(kPos) * dt;
+  const Vector3d p = p_pos_ - origin_;
+  const Matrix3d vx = qg * skew(v_);
+  const Matrix3d px = qg * skew(p);
+  auto a = a_.topRows<9>();
+  a.block<3, 3>(kRot, kRot).diagonal().array() += qg;
+  a.block<3, 3>(kVel, kRot) += vx;
+  a.block<3, 3>(kRot, kVel) -= vx;
+  a.block<3, 3>(kPos, kRot) += px;
+  a.block<3, 3>(kRot, kPos) -= px;
+  Matrix3d vv = -qg * v_ * v_.transpose();
+  vv.diagonal().array() += qg * v_.squaredNorm() + qa;
+  a.block<3, 3>(kVel, kVel) += vv;
+  Matrix3d pv = -qg * v_ * p.transpose();
+  pv.diagonal().array() += qg * p.dot(v_);
+  a.block<3, 3>(kPos, kVel) += pv;
+  a.block<3, 3>(kVel, kPos) += pv.transpose();
+  Matrix3d pp = -qg * p * p.transpose();
+  pp.diagonal().array() += qg * p.squaredNorm() + qp;
+  a.block<3, 3>(kPos, kPos) += pp;
+  c_.diagonal() += q_diag_.tail<6>() * dt;
+}
+
+void LeftInekf::apply_step(const InekfImuStep& step) {
+  // Phi = [[F, G], [0, I]] on P = [[A, B], [B^T, C]] gives
+  //   B+ = F B + G C,  A+ = F A F^T + W G^T + G W^T with W = F B + G C / 2,  C+ = C.
+  // The blocks are kept with a zero tenth row so that every column is whole SIMD packets.
+  const Vector3d& g = params_.gravity;
+  const double dt = step.dt;
+  const PaddedBlock6& gmat = step.bias_coupling;
+  PaddedBlock6 fb = b_;
+  shear_rows(fb, g, dt);
+  PaddedBlock6 gc;
+  gc.noalias() = gmat.lazyProduct(c_);
+  b_ = fb + gc;
+  const PaddedBlock6 w = fb + 0.5 * gc;
+  PaddedBlock9 wg;  // W G^T; the rotation rows of G have no accel-bias part
+  wg.leftCols<3>().noalias() = w.leftCols<3>().lazyProduct(gmat.block<3, 3>(kRot, 0).transpose());
+  wg.rightCols<6>().noalias() = w.lazyProduct(gmat.middleRows<6>(kVel).transpose());
+  shear_rows(a_, g, dt);  // F A, then F A F^T
+  shear_columns(a_, g, dt);
+  a_ += wg;
+  a_.topRows<9>() += wg.topRows<9>().transpose();
 }
 
 void LeftInekf::propagate(const Vector3d& gyro, const Vector3d& accel, double dt) {
   const Vector3d w = gyro - bg_;
   const Vector3d a = accel - ba_;
-  // P- = Phi (P + Q dt) Phi^T
-  p_.diagonal() += q_diag_ * dt;
-  const LeftInekfTransition t = LeftInekfTransition::compute(w, a, dt);
-  apply_transition(t);
-
   const Vector3d& g = params_.gravity;
-  p_pos_ += v_ * dt + r_ * t.u2 + (0.5 * dt * dt) * g;
-  v_ += r_ * t.u1 + dt * g;
-  r_ = r_ * t.omega.transpose();  // R Gamma0(w dt)
+  // P- = Phi (P + Q dt) Phi^T
+  add_process_noise(dt);
+  const InekfImuStep step = InekfImuStep::compute(r_, v_, p_pos_ - origin_, w, a, dt, g);
+  apply_step(step);
+
+  p_pos_ += v_ * dt + r_ * step.u2 + (0.5 * dt * dt) * g;
+  v_ += r_ * step.u1 + dt * g;
+  r_ = r_ * step.rotation_increment;
   if (++steps_since_normalise_ >= kNormaliseEvery) {
     r_ = Eigen::Quaterniond(r_).normalized().toRotationMatrix();
     steps_since_normalise_ = 0;
   }
+  // Without fixes (outage, dead reckoning) the robot drifts away from the origin; follow it.
+  if ((p_pos_ - origin_).squaredNorm() > kMaxOriginDistance * kMaxOriginDistance) {
+    move_origin(Matrix3d::Identity(), Vector3d::Zero(), Vector3d::Zero());
+  }
 }
 
-void LeftInekf::retract(const Vector15& delta) {
-  // X+ = X exp(delta) on SE_2(3); biases are additive.
+void LeftInekf::move_origin(const Matrix3d& e, const Vector3d& dv, const Vector3d& dp) {
+  // Re-expressing xi_o at origin o' = p is the adjoint of the pure translation (I, 0, o - o'),
+  // composed here with Ad_E of a correction: (e, dv, dp + o - o').
+  const Vector3d shift = origin_ - p_pos_;
+  origin_ = p_pos_;
+  const Vector3d dp_shifted = dp + shift;
+  Matrix9 ad_a = a_.topRows<9>();
+  apply_adjoint(ad_a, e, dv, dp_shifted);
+  Eigen::Matrix<double, 9, 6> ad_b = b_.topRows<9>();
+  apply_adjoint(ad_b, e, dv, dp_shifted);
+  b_.topRows<9>() = ad_b;
+  Matrix9 a = ad_a.transpose();
+  apply_adjoint(a, e, dv, dp_shifted);
+  a_.topRows<9>() = a;
+}
+
+void LeftInekf::correct_world(const Vector15& delta) {
   const Vector3d phi = delta.segment<3>(kRot);
   const auto c = gamma_coefficients(phi.norm());
   const Matrix3d k = skew(phi);
   const Matrix3d k2 = k * k;
-  const Matrix3d g0 = Matrix3d::Identity() + c.a0 * k + c.b0 * k2;
+  const Matrix3d e = Matrix3d::Identity() + c.a0 * k + c.b0 * k2;
   const Matrix3d g1 = Matrix3d::Identity() + c.a1 * k + c.b1 * k2;
-  v_ += r_ * (g1 * delta.segment<3>(kVel));
-  p_pos_ += r_ * (g1 * delta.segment<3>(kPos));
-  r_ = r_ * g0;
+  const Vector3d dv = g1 * delta.segment<3>(kVel);
+  const Vector3d dp = g1 * delta.segment<3>(kPos);
+  r_ = e * r_;
+  v_ = e * v_ + dv;
+  p_pos_ = origin_ + e * (p_pos_ - origin_) + dp;
   bg_ += delta.segment<3>(kGyroBias);
   ba_ += delta.segment<3>(kAccelBias);
+  // The updated covariance describes the left-invariant error at the corrected state; its
+  // world form there is Ad_{X+} P Ad_{X+}^T = Ad_E P_w Ad_E^T with E = exp(delta). The origin
+  // moves to the corrected position in the same transform.
+  move_origin(e, dv, dp);
 }
 
 CorrectionResult LeftInekf::correct_position(const Vector3d& position, const Matrix3d& covariance,
                                              const Vector3d& lever_arm, double gate2) {
-  // Y = X b with b = (lever, 0, 1): innovation X^-1 Y - b = R^T (y - p) - lever, which is
-  // xi_p - [lever]x xi_R to first order, with noise R^T N R.
+  // Y = X b with b = (lever, 0, 1). In world form the residual y - (p + R lever) is
+  // rho_p - [p + R lever]x phi to first order (the left innovation R^T (y - p) - lever rotated
+  // to the world), with noise N itself.
   CorrectionResult out;
-  out.residual = position - (p_pos_ + r_ * lever_arm);
-  const Vector3d z = r_.transpose() * out.residual;
+  const Vector3d antenna = p_pos_ + r_ * lever_arm;
+  out.residual = position - antenna;
   Matrix3x15 h = Matrix3x15::Zero();
-  h.block<3, 3>(0, kRot) = -skew(lever_arm);
+  h.block<3, 3>(0, kRot) = -skew(antenna - origin_);
   h.block<3, 3>(0, kPos).setIdentity();
-  const Matrix3d n = r_.transpose() * covariance * r_;
-  const KalmanUpdate u = joseph_update(p_, z, h, n, gate2);
+  Matrix15 p = world_covariance();
+  const KalmanUpdate u = joseph_update(p, out.residual, h, covariance, gate2);
   out.accepted = u.accepted;
   out.mahalanobis2 = u.mahalanobis2;
-  if (u.accepted) retract(u.delta);
+  if (u.accepted) {
+    set_world_covariance(p);
+    correct_world(u.delta);
+  }
   return out;
 }
 
@@ -253,20 +221,24 @@ CorrectionResult LeftInekf::correct_velocity(const Vector3d& velocity, const Mat
                                              double gate2) {
   CorrectionResult out;
   out.residual = velocity - v_;
-  const Vector3d z = r_.transpose() * out.residual;
   Matrix3x15 h = Matrix3x15::Zero();
+  h.block<3, 3>(0, kRot) = -skew(v_);
   h.block<3, 3>(0, kVel).setIdentity();
-  const Matrix3d n = r_.transpose() * covariance * r_;
-  const KalmanUpdate u = joseph_update(p_, z, h, n, gate2);
+  Matrix15 p = world_covariance();
+  const KalmanUpdate u = joseph_update(p, out.residual, h, covariance, gate2);
   out.accepted = u.accepted;
   out.mahalanobis2 = u.mahalanobis2;
-  if (u.accepted) retract(u.delta);
+  if (u.accepted) {
+    set_world_covariance(p);
+    correct_world(u.delta);
+  }
   return out;
 }
 
 void LeftInekf::inflate(const Matrix3d& position_covariance, const Matrix3d& velocity_covariance) {
-  p_.block<3, 3>(kPos, kPos) += r_.transpose() * position_covariance * r_;
-  p_.block<3, 3>(kVel, kVel) += r_.transpose() * velocity_covariance * r_;
+  // World-frame position and velocity errors are exactly the vel/pos blocks of xi_w.
+  a_.block<3, 3>(kPos, kPos) += position_covariance;
+  a_.block<3, 3>(kVel, kVel) += velocity_covariance;
 }
 
 NavState LeftInekf::state() const {
@@ -292,12 +264,43 @@ Vector15 LeftInekf::error_from(const NavState& truth) const {
   return e;
 }
 
-Eigen::Matrix3d LeftInekf::rotation_covariance_world() const {
-  return r_ * p_.block<3, 3>(kRot, kRot) * r_.transpose();
+NavState LeftInekf::relative_state() const {
+  NavState s = state();
+  s.position -= origin_;
+  return s;
 }
 
+Matrix15 LeftInekf::covariance() const {
+  const Matrix15 t = left_from_world(relative_state());
+  const Matrix15 p = t * world_covariance() * t.transpose();
+  return 0.5 * (p + p.transpose());
+}
+
+Matrix15 LeftInekf::world_covariance() const {
+  Matrix15 p;
+  p.topLeftCorner<9, 9>() = a_.topRows<9>();
+  p.topRightCorner<9, 6>() = b_.topRows<9>();
+  p.bottomLeftCorner<6, 9>() = b_.topRows<9>().transpose();
+  p.bottomRightCorner<6, 6>() = c_;
+  return p;
+}
+
+void LeftInekf::set_world_covariance(const Matrix15& p) {
+  a_.topRows<9>() = p.topLeftCorner<9, 9>();
+  a_.row(9).setZero();
+  b_.topRows<9>() = p.topRightCorner<9, 6>();
+  b_.row(9).setZero();
+  c_ = p.bottomRightCorner<6, 6>();
+}
+
+Eigen::Matrix3d LeftInekf::rotation_covariance_world() const { return a_.block<3, 3>(kRot, kRot); }
+
 Eigen::Matrix3d LeftInekf::position_covariance_world() const {
-  return r_ * p_.block<3, 3>(kPos, kPos) * r_.transpose();
+  // R xi_p = rho_p - [p - o]x phi.
+  Eigen::Matrix<double, 3, 9> l = Eigen::Matrix<double, 3, 9>::Zero();
+  l.block<3, 3>(0, kRot) = -skew(p_pos_ - origin_);
+  l.block<3, 3>(0, kPos).setIdentity();
+  return l * a_.topRows<9>() * l.transpose();
 }
 
 }  // namespace semap::estimation

@@ -6,6 +6,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "semap/estimation/chi_square.hpp"
+#include "semap/estimation/kalman_update.hpp"
 #include "semap/estimation/so3.hpp"
 
 namespace semap::estimation {
@@ -43,7 +44,17 @@ NavState some_state() {
   return s;
 }
 
-TEST(LeftInekf, TransitionMatchesNumericalExpm) {
+// The state after one step with the increments of `step`, as the filter applies them.
+NavState advance(const NavState& s, const InekfImuStep& step, const Vector3d& g) {
+  NavState out = s;
+  const double dt = step.dt;
+  out.rotation = s.rotation * step.rotation_increment;
+  out.velocity = s.velocity + s.rotation * step.u1 + g * dt;
+  out.position = s.position + s.velocity * dt + s.rotation * step.u2 + 0.5 * dt * dt * g;
+  return out;
+}
+
+TEST(LeftInekf, WorldTransitionMatchesNumericalExpm) {
   struct Case {
     Vector3d w, a;
     double dt;
@@ -54,15 +65,31 @@ TEST(LeftInekf, TransitionMatchesNumericalExpm) {
       {Vector3d(0.0, 0.0, 0.0), Vector3d(0.0, 0.0, 9.81), 0.01},
       {Vector3d(2.0, 1.0, -3.0), Vector3d(-5.0, 2.0, 12.0), 0.02},
       {Vector3d(0.2, 0.1, 0.4), Vector3d(1.0, 0.5, 9.8), 0.1},
+      {Vector3d(20.0, -5.0, 8.0), Vector3d(1.0, 0.5, 9.8), 0.1},  // 2.2 rad in one step
   };
+  const FilterParams params;
+  const NavState s = some_state();
   for (const auto& c : cases) {
-    const Matrix15 numeric = (error_dynamics(c.w, c.a) * c.dt).exp();
-    const Matrix15 closed = LeftInekfTransition::compute(c.w, c.a, c.dt).dense();
-    // The gyro-bias coupling blocks are quadrature: exact to (|w| dt)^6 relative.
+    const InekfImuStep step =
+        InekfImuStep::compute(s.rotation, s.velocity, s.position, c.w, c.a, c.dt, params.gravity);
+    EXPECT_TRUE(step.rotation_increment.isApprox(gamma0(c.w * c.dt), 1e-14));
+    EXPECT_TRUE(step.u1.isApprox(gamma1(c.w * c.dt) * c.a * c.dt, 1e-14));
+    EXPECT_TRUE(step.u2.isApprox(gamma2(c.w * c.dt) * c.a * c.dt * c.dt, 1e-14));
+    // Phi_w = T(X+) expm(A dt) T(X)^-1 with A the left-invariant error dynamics.
+    const Matrix15 left = (error_dynamics(c.w, c.a) * c.dt).exp();
+    const Matrix15 numeric =
+        world_from_left(advance(s, step, params.gravity)) * left * left_from_world(s);
+    const Matrix15 closed = step.dense(params.gravity);
+    // The gyro-bias couplings are truncated series: 1e-13 relative to their leading term.
     EXPECT_LT((closed - numeric).cwiseAbs().maxCoeff(), 1e-11 * std::max(1.0, numeric.norm()))
         << "w " << c.w.transpose() << " dt " << c.dt << "\n"
         << (closed - numeric);
   }
+}
+
+TEST(LeftInekf, AdjointMapsAreInverse) {
+  const NavState s = some_state();
+  EXPECT_LT((world_from_left(s) * left_from_world(s) - Matrix15::Identity()).norm(), 1e-12);
 }
 
 TEST(LeftInekf, CovariancePropagationEqualsDenseFormula) {
@@ -75,10 +102,47 @@ TEST(LeftInekf, CovariancePropagationEqualsDenseFormula) {
   const Vector3d accel(0.4, 0.2, 9.7);
   const double dt = 0.01;
   f.propagate(gyro, accel, dt);
-  const Matrix15 phi = LeftInekfTransition::compute(gyro, accel, dt).dense();
+  const Matrix15 phi = (error_dynamics(gyro, accel) * dt).exp();
   const Matrix15 q = process_noise_diagonal(params.noise).asDiagonal();
   const Matrix15 expected = phi * (p0 + q * dt) * phi.transpose();
-  EXPECT_LT((f.covariance() - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_LT((f.covariance() - expected).norm(), 1e-11 * expected.norm());
+}
+
+// The world-form update must be the left-invariant EKF update, written here in its textbook
+// form: H = [-[lever]x 0 I 0 0], z = R^T (y - p) - lever, N_b = R^T N R, X+ = X exp(K z).
+TEST(LeftInekf, CorrectionEqualsTextbookLeftInvariantUpdate) {
+  std::mt19937_64 rng(11);
+  FilterParams params;
+  LeftInekf f(params);
+  f.reset(some_state(), random_spd(rng) * 0.1);
+  for (int k = 0; k < 50; ++k) f.propagate(Vector3d(0.1, -0.2, 0.4), Vector3d(0.3, 0.1, 9.8), 0.01);
+  const NavState x = f.state();
+  const Matrix15 p = f.covariance();
+  const Vector3d lever(0.4, -0.1, 1.1);
+  const Vector3d y = x.position + x.rotation * lever + Vector3d(0.3, -0.2, 0.1);
+  const Matrix3d n = Vector3d(0.04, 0.05, 0.09).asDiagonal();
+
+  Matrix3x15 h = Matrix3x15::Zero();
+  h.block<3, 3>(0, kRot) = -skew(lever);
+  h.block<3, 3>(0, kPos).setIdentity();
+  const Vector3d z = x.rotation.transpose() * (y - x.position) - lever;
+  const Matrix3d nb = x.rotation.transpose() * n * x.rotation;
+  const Matrix3d s = h * p * h.transpose() + nb;
+  const Eigen::Matrix<double, 15, 3> gain = p * h.transpose() * s.inverse();
+  const Vector15 delta = gain * z;
+  const Matrix15 a = Matrix15::Identity() - gain * h;
+  const Matrix15 p_expected = a * p * a.transpose() + gain * nb * gain.transpose();
+  const Matrix3d g1 = gamma1(delta.head<3>());
+
+  const CorrectionResult r = f.correct_position(y, n, lever, 1e9);
+  ASSERT_TRUE(r.accepted);
+  EXPECT_NEAR(r.mahalanobis2, z.dot(s.inverse() * z), 1e-9 * r.mahalanobis2);
+  const NavState got = f.state();
+  EXPECT_LT((got.rotation - x.rotation * gamma0(delta.head<3>())).norm(), 1e-12);
+  EXPECT_LT((got.velocity - (x.velocity + x.rotation * g1 * delta.segment<3>(kVel))).norm(), 1e-10);
+  EXPECT_LT((got.position - (x.position + x.rotation * g1 * delta.segment<3>(kPos))).norm(), 1e-10);
+  EXPECT_LT((got.gyro_bias - delta.segment<3>(kGyroBias)).norm(), 1e-12);
+  EXPECT_LT((f.covariance() - p_expected).norm(), 1e-10 * p_expected.norm());
 }
 
 // Log-linear property: with identical inputs, exp(xi) = X_hat^-1 X evolves exactly as
@@ -112,7 +176,7 @@ TEST(LeftInekf, PropagationIsInvariantAndLogLinear) {
       const Vector3d accel(1.0 + std::sin(3 * t), 0.5, 9.8);
       fe.propagate(gyro, accel, 0.01);
       ft.propagate(gyro, accel, 0.01);
-      xi = LeftInekfTransition::compute(gyro, accel, 0.01).dense().topLeftCorner<9, 9>() * xi;
+      xi = (error_dynamics(gyro, accel) * 0.01).exp().topLeftCorner<9, 9>() * xi;
     }
     const Vector15 e = fe.error_from(ft.state());
     EXPECT_LT((e.head<9>() - xi).norm(), 1e-9 * xi.norm()) << e.head<9>().transpose() << "\n"
@@ -162,7 +226,7 @@ TEST(LeftInekf, CovarianceStaysSymmetricPositiveDefinite) {
       f.correct_velocity(f.state().velocity, Matrix3d::Identity() * 1e-2, gate2);
     }
   }
-  const Matrix15& p = f.covariance();
+  const Matrix15 p = f.covariance();
   EXPECT_LT((p - p.transpose()).norm(), 1e-15 * p.norm());
   Eigen::SelfAdjointEigenSolver<Matrix15> es(p);
   EXPECT_GT(es.eigenvalues().minCoeff(), 0.0);

@@ -38,7 +38,7 @@ class NavFilter {
                        const Eigen::Matrix3d& velocity_covariance) = 0;
 
   virtual NavState state() const = 0;
-  virtual const Matrix15& covariance() const = 0;
+  virtual Matrix15 covariance() const = 0;
   // Error of this estimate with respect to `truth` in the filter's own error coordinates.
   virtual Vector15 error_from(const NavState& truth) const = 0;
   // Covariance of rotation (world axes, rad^2) and position (world, m^2) for reporting.

@@ -28,7 +28,7 @@ class QuaternionEskf final : public NavFilter {
                const Eigen::Matrix3d& velocity_covariance) override;
 
   NavState state() const override;
-  const Matrix15& covariance() const override { return p_; }
+  Matrix15 covariance() const override { return p_; }
   Vector15 error_from(const NavState& truth) const override;
   Eigen::Matrix3d rotation_covariance_world() const override;
   Eigen::Matrix3d position_covariance_world() const override;

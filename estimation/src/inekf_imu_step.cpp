@@ -1,0 +1,188 @@
+#include "semap/estimation/inekf_imu_step.hpp"
+
+#include <Eigen/Geometry>
+#include <array>
+
+#include "semap/estimation/so3.hpp"
+
+namespace semap::estimation {
+
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// The gyro-bias couplings need J1 = int_0^dt [u(s)]x e^{W s} ds with u(s) = s Gamma1(w s) a and
+// J2 = int_0^dt [s^2 Gamma2(w s) a + (dt - s) u(s)]x e^{W s} ds. Expanding both exponentials in
+// W_hat = [w dt]x gives J1 = dt^2 sum_kj alpha_kj [W_hat^k a]x W_hat^j and J2 = dt^3 sum_kj
+// beta_kj [W_hat^k a]x W_hat^j, entire series whose terms of total order n = k + j shrink
+// like (2 |w| dt)^n / (n + 2)!. Since W_hat^3 = t W_hat with t = -|w dt|^2, every W_hat^k a is
+// a power of t times a, W_hat a or W_hat^2 a, and every W_hat^j a power of t times I, W_hat or
+// W_hat^2, so each series collapses to 3x3 scalar polynomials in t:
+//   J = [x0]x + [x1]x W_hat + [x2]x W_hat^2,  x_tau = sum_kappa S_kappa,tau(t) b_kappa,
+// with b = (a, W_hat a, W_hat^2 a). Only a few powers of t are needed at IMU rates.
+constexpr int kMaxPower = 20;               // of t: reaches total order 40 (|w dt| ~ 4 rad)
+constexpr double kSeriesTolerance = 1e-13;  // relative to the leading term
+
+int basis_of(int k) { return k == 0 ? 0 : (k % 2 == 1 ? 1 : 2); }
+int t_power_of(int k) { return k == 0 ? 0 : (k - 1) / 2; }
+
+// Coefficient of t^m of S1 (entries 0..8) and S2 (9..17), entry 3 kappa + tau, so that all
+// 18 polynomials are evaluated together as one vector.
+using SeriesCoefficients = Eigen::Matrix<double, 18, 1>;
+using CollapsedSeries = std::array<SeriesCoefficients, kMaxPower + 1>;
+
+CollapsedSeries make_collapsed_series() {
+  constexpr int kMaxIndex = 2 * kMaxPower + 2;
+  std::array<double, kMaxIndex + 4> factorial{};
+  factorial[0] = 1.0;
+  for (std::size_t i = 1; i < factorial.size(); ++i) factorial[i] = factorial[i - 1] * i;
+  CollapsedSeries s;
+  for (auto& c : s) c.setZero();
+  for (int k = 0; k <= kMaxIndex; ++k) {
+    for (int j = 0; j <= kMaxIndex; ++j) {
+      const int m = t_power_of(k) + t_power_of(j);
+      if (m > kMaxPower) continue;
+      const double n = k + j;
+      const double alpha = 1.0 / ((n + 2.0) * factorial[k + 1] * factorial[j]);
+      const double beta = (1.0 / factorial[k + 2] + 1.0 / (factorial[k + 1] * (n + 2.0))) /
+                          (factorial[j] * (n + 3.0));
+      s[m](3 * basis_of(k) + basis_of(j)) += alpha;
+      s[m](9 + 3 * basis_of(k) + basis_of(j)) += beta;
+    }
+  }
+  return s;
+}
+
+const CollapsedSeries kSeries = make_collapsed_series();
+
+// Largest |w dt| for which powers of t up to M suffice, i.e. the first omitted terms (total
+// order 2M + 1, size ~ (2 theta)^(2M+1) / (2M + 3)! relative to the leading one) are below
+// the tolerance; found once by bisection so the per-step choice is a few comparisons.
+std::array<double, kMaxPower + 1> make_series_limits() {
+  const auto omitted = [](double theta, int n) {
+    double e = theta * 4.0 / 6.0;
+    for (int i = 1; i <= n; ++i) e *= 2.0 * theta / (i + 3.0);
+    return e;
+  };
+  std::array<double, kMaxPower + 1> limits{};
+  for (int m = 0; m <= kMaxPower; ++m) {
+    double lo = 0.0;
+    double hi = 8.0;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (omitted(mid, 2 * m) <= kSeriesTolerance ? lo : hi) = mid;
+    }
+    limits[m] = lo;
+  }
+  return limits;
+}
+
+const std::array<double, kMaxPower + 1> kSeriesLimits = make_series_limits();
+
+int series_power(double theta) {
+  int m = 0;
+  while (m < kMaxPower && theta > kSeriesLimits[m]) ++m;
+  return m;
+}
+
+// [x0]x + [x1]x [phi]x + [x2]x [phi]x^2, with [x]x [phi]x = phi x^T - (x.phi) I and
+// [x]x [phi]x^2 = phi (x cross phi)^T - (x.phi) [phi]x.
+Matrix3d collapsed_matrix(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2,
+                          const Vector3d& phi, const Matrix3d& phi_x) {
+  Matrix3d m = skew(x0) - x2.dot(phi) * phi_x;
+  m.noalias() += phi * (x1 + x2.cross(phi)).transpose();
+  m.diagonal().array() -= x1.dot(phi);
+  return m;
+}
+
+}  // namespace
+
+Matrix9 se23_adjoint(const Matrix3d& r, const Vector3d& v, const Vector3d& p) {
+  Matrix9 ad = Matrix9::Zero();
+  ad.block<3, 3>(kRot, kRot) = r;
+  ad.block<3, 3>(kVel, kVel) = r;
+  ad.block<3, 3>(kPos, kPos) = r;
+  ad.block<3, 3>(kVel, kRot) = skew(v) * r;
+  ad.block<3, 3>(kPos, kRot) = skew(p) * r;
+  return ad;
+}
+
+Matrix15 world_from_left(const NavState& s) {
+  Matrix15 t = Matrix15::Identity();
+  t.topLeftCorner<9, 9>() = se23_adjoint(s.rotation, s.velocity, s.position);
+  return t;
+}
+
+Matrix15 left_from_world(const NavState& s) {
+  // Ad_X^-1 = Ad_{X^-1} with X^-1 = (R^T, -R^T v, -R^T p).
+  const Matrix3d rt = s.rotation.transpose();
+  Matrix15 t = Matrix15::Identity();
+  t.topLeftCorner<9, 9>() = se23_adjoint(rt, -rt * s.velocity, -rt * s.position);
+  return t;
+}
+
+InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const Vector3d& p,
+                                   const Vector3d& w, const Vector3d& a, double dt,
+                                   const Vector3d& gravity) {
+  InekfImuStep step;
+  step.dt = dt;
+  const Vector3d phi = w * dt;
+  const double theta = phi.norm();
+  const auto c = gamma_coefficients(theta);
+  const Matrix3d k = skew(phi);
+  // K^2 = phi phi^T - |phi|^2 I.
+  Matrix3d k2 = phi * phi.transpose();
+  k2.diagonal().array() -= phi.squaredNorm();
+  step.rotation_increment = Matrix3d::Identity() + c.a0 * k + c.b0 * k2;
+  const Matrix3d g1 = Matrix3d::Identity() + c.a1 * k + c.b1 * k2;
+  const Matrix3d g2 = 0.5 * Matrix3d::Identity() + c.a2 * k + c.b2 * k2;
+  step.u1.noalias() = g1 * (a * dt);
+  step.u2.noalias() = g2 * (a * (dt * dt));
+
+  // G = int_0^dt F(dt - s) Ad_X(s) B ds with B = -[I 0; 0 I; 0 0]: every block is a rotation
+  // integral of R(s) = R e^{W s} (int R(s) ds = R Gamma1 dt, int (dt - s) R(s) ds = R Gamma2 dt^2)
+  // plus the translation terms carried by the series integrals J1, J2.
+  const Matrix3d a1 = r * (g1 * dt);
+  const Matrix3d a2 = r * (g2 * (dt * dt));
+  const double t = -phi.squaredNorm();
+  const int degree = series_power(theta);
+  SeriesCoefficients s = kSeries[degree];
+  for (int m = degree - 1; m >= 0; --m) s = s * t + kSeries[m];
+  Matrix3d basis;  // columns a, W_hat a, W_hat^2 a
+  basis.col(0) = a;
+  basis.col(1) = phi.cross(a);
+  basis.col(2) = phi.cross(basis.col(1));
+  // x_tau = sum_kappa S(kappa, tau) b_kappa, i.e. X = basis S with S stored row-major.
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s1(s.data());
+  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s2(s.data() + 9);
+  const Matrix3d x1 = basis * s1;
+  const Matrix3d x2 = basis * s2;
+  Eigen::Matrix<double, 3, 6> j;
+  j.leftCols<3>() = (dt * dt) * collapsed_matrix(x1.col(0), x1.col(1), x1.col(2), phi, k);
+  j.rightCols<3>() = (dt * dt * dt) * collapsed_matrix(x2.col(0), x2.col(1), x2.col(2), phi, k);
+  Eigen::Matrix<double, 3, 6> rj;
+  rj.noalias() = r * j;
+  const Vector3d v_end = v + gravity * dt;                        // v + g dt
+  const Vector3d p_end = p + v * dt + (0.5 * dt * dt) * gravity;  // p + v dt + g dt^2/2
+  auto& g = step.bias_coupling;
+  g.setZero();
+  g.block<3, 3>(kRot, 0) = -a1;
+  g.block<3, 3>(kVel, 0).noalias() = -skew(v_end) * a1 - rj.leftCols<3>();
+  g.block<3, 3>(kPos, 0).noalias() = -skew(p_end) * a1 - rj.rightCols<3>();
+  g.block<3, 3>(kVel, 3) = -a1;
+  g.block<3, 3>(kPos, 3) = -a2;
+  return step;
+}
+
+Matrix15 InekfImuStep::dense(const Vector3d& gravity) const {
+  Matrix15 f = Matrix15::Identity();
+  const Matrix3d gx = skew(gravity);
+  f.block<3, 3>(kVel, kRot) = gx * dt;
+  f.block<3, 3>(kPos, kRot) = gx * (0.5 * dt * dt);
+  f.block<3, 3>(kPos, kVel) = Matrix3d::Identity() * dt;
+  f.topRightCorner<9, 6>() = bias_coupling.topRows<9>();
+  return f;
+}
+
+}  // namespace semap::estimation
