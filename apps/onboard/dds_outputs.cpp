@@ -27,6 +27,9 @@ DdsOutputs::DdsOutputs(const OnboardConfig& config)
                       dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
       odometry_writer_(participant_, odometry_topic_,
                        dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
+      health_topic_(participant_, dds_idl::topic_name(config.dds.ns, dds_idl::SemapTopic::kHealth),
+                    dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
+      health_writer_(participant_, health_topic_, dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
       map_publisher_(participant_,
                      dds_idl::MapPublisherConfig{config.dds.ns, config.dds.frame_id,
                                                  config.dds.publish_hz, config.dds.cloud_hz},
@@ -47,6 +50,12 @@ void DdsOutputs::publish_pose(const PoseOutput& pose) {
   dds_idl::to_msg(p, config_.dds.frame_id, child, msg);
   odometry_writer_.write(msg);
   odometry_written_.fetch_add(1);
+}
+
+void DdsOutputs::publish_health(const dds_idl::HealthReport& report) {
+  const dds_idl::HealthMessage m(report, config_.dds.frame_id);
+  health_writer_.write(m.get());
+  ++health_written_;
 }
 
 void DdsOutputs::publish_blocks(std::vector<dds_idl::BlockSnapshot>&& blocks, common::Stamp now) {
