@@ -30,7 +30,9 @@ TEST(LatencyWindow, RecordsFromAnotherThreadWhileRead) {
   });
   for (int i = 0; i < 200; ++i) {
     const auto p = w.percentiles();
-    if (p.count > 0) EXPECT_FLOAT_EQ(p.p50_ms, 2.0f);
+    if (p.count > 0) {
+      EXPECT_FLOAT_EQ(p.p50_ms, 2.0f);
+    }
   }
 }
 
