@@ -1,12 +1,14 @@
-// What one semap-fusion merge round costs without DDS: mapping::merge_into of a robot's whole
-// layer (identity, or the 10 m shift of the DDS test, which resamples), and turning a fused
-// block into the DDS block that is republished.
+// What semap-fusion's merging costs without DDS: mapping::merge_into of a robot's whole layer
+// (identity, or a 10 m shift, which resamples), the incremental re-merge semap-fusion does
+// when one block of such a layer changes, and turning a fused block into the DDS block that is
+// republished.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <random>
 
 #include "semap/fusion/block_layers.hpp"
+#include "semap/fusion/incremental_merge.hpp"
 #include "semap/mapping/map_merge.hpp"
 
 namespace {
@@ -56,6 +58,24 @@ void BM_MergeLayerIdentity(benchmark::State& state) { merge_layer(state, 0.0); }
 void BM_MergeLayerShifted10m(benchmark::State& state) { merge_layer(state, 10.05); }
 BENCHMARK(BM_MergeLayerIdentity)->Arg(500)->Arg(2000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MergeLayerShifted10m)->Arg(500)->Arg(2000)->Unit(benchmark::kMillisecond);
+
+// One changed block of a robot layer of range(0) blocks, shifted 10 m: what MapFusion does.
+void BM_RemergeOneChangedBlock(benchmark::State& state) {
+  const LayeredMap robot = robot_map(static_cast<int>(state.range(0)), 2);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation().x() = 10.05;
+  LayeredMap fused(params());
+  semap::mapping::merge_into(fused, robot, T);
+  const auto& layer = *robot.find_layer(2);
+  const BlockIndex changed{3, 3, 0};
+  for (auto _ : state) {
+    const auto targets = semap::fusion::touched_blocks(changed, params(), params(), T);
+    semap::fusion::remerge_blocks(fused, 2, layer, params(), targets, T);
+    benchmark::DoNotOptimize(fused);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RemergeOneChangedBlock)->Arg(500)->Arg(2000)->Unit(benchmark::kMicrosecond);
 
 void BM_FusedSnapshot(benchmark::State& state) {
   LayeredMap fused = robot_map(64, 1);

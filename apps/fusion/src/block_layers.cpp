@@ -2,12 +2,10 @@
 
 #include <algorithm>
 #include <bit>
-#include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "semap/mapping/cell_summary.hpp"
-#include "semap/mapping/grid_index.hpp"
 
 namespace semap::fusion {
 
@@ -69,47 +67,6 @@ std::optional<dds_idl::BlockSnapshot> fused_snapshot(const mapping::LayeredMap& 
     }
   }
   return snap;
-}
-
-std::vector<mapping::BlockIndex> touched_blocks(const mapping::BlockIndex& key,
-                                                const mapping::LayeredMapParams& from,
-                                                const mapping::LayeredMapParams& to,
-                                                const Eigen::Isometry3d& T_to_from) {
-  const int side = from.block_side();
-  const double size = side * from.resolution;
-  const Eigen::Vector3d lo = Eigen::Vector3d(key.x, key.y, key.z) * size;
-  Eigen::Vector3d box_min = Eigen::Vector3d::Constant(1e300);
-  Eigen::Vector3d box_max = Eigen::Vector3d::Constant(-1e300);
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d offset((corner & 1) ? 1.0 : 0.0, (corner & 2) ? 1.0 : 0.0,
-                                 (corner & 4) ? 1.0 : 0.0);
-    const Eigen::Vector3d q = T_to_from * (lo + offset * size);
-    box_min = box_min.cwiseMin(q);
-    box_max = box_max.cwiseMax(q);
-  }
-  // Target cells whose centre lies in [box_min, box_max); the margin keeps rounding from ever
-  // dropping a boundary cell (it may add one, which only costs a republished block).
-  constexpr double kMargin = 1e-6;
-  const auto first_cell = [&](double v) {
-    return static_cast<int>(std::ceil(v / to.resolution - 0.5 - kMargin));
-  };
-  const auto last_cell = [&](double v) {
-    return static_cast<int>(std::ceil(v / to.resolution - 0.5 + kMargin)) - 1;
-  };
-  const mapping::CellIndex first(first_cell(box_min.x()), first_cell(box_min.y()),
-                                 first_cell(box_min.z()));
-  const mapping::CellIndex last(last_cell(box_max.x()), last_cell(box_max.y()),
-                                last_cell(box_max.z()));
-  std::vector<mapping::BlockIndex> out;
-  if ((last.array() < first.array()).any()) return out;
-  const mapping::BlockIndex b0 = mapping::block_of_cell(first, to.block_side());
-  const mapping::BlockIndex b1 = mapping::block_of_cell(last, to.block_side());
-  for (int z = b0.z; z <= b1.z; ++z) {
-    for (int y = b0.y; y <= b1.y; ++y) {
-      for (int x = b0.x; x <= b1.x; ++x) out.push_back({x, y, z});
-    }
-  }
-  return out;
 }
 
 }  // namespace semap::fusion

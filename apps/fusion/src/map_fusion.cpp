@@ -6,7 +6,7 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/fusion/block_layers.hpp"
-#include "semap/mapping/map_merge.hpp"
+#include "semap/fusion/incremental_merge.hpp"
 
 namespace semap::fusion {
 
@@ -40,7 +40,7 @@ MapFusion::MapFusion(const dds_idl::Participant& participant, MapFusionConfig co
                             static_cast<mapping::SourceId>(i + 1),
                             std::make_unique<dds_idl::MapClient>(
                                 participant, client_config(source.ns, config_.description)),
-                            mapping::LayeredMap(params_),
+                            mapping::EvidenceGrid(params_.block_side(), params_.channels()),
                             {},
                             {}});
   }
@@ -50,7 +50,7 @@ void MapFusion::take_blocks(Robot& robot) {
   robot.client->poll();
   const std::vector<dds_idl::BlockIndex> changed = robot.client->take_changed();
   if (changed.empty()) return;
-  mapping::EvidenceGrid& layer = robot.local.layer(robot.id);
+  mapping::EvidenceGrid& layer = robot.layer;
   const std::size_t before = robot.changed.size();
   for (const dds_idl::BlockIndex& index : changed) {
     const dds_idl::BlockSnapshot& block = robot.client->blocks().at(index);
@@ -68,7 +68,7 @@ void MapFusion::take_blocks(Robot& robot) {
     robot.changed.push_back(key);
     ++robot.counters.blocks;
   }
-  // merge_into replaces a robot's layer only by a copy with more updates.
+  // The update count orders copies of a layer, as in the mapping library (merge_into, .smap).
   if (robot.changed.size() > before) layer.set_updates(layer.updates() + 1);
 }
 
@@ -77,13 +77,18 @@ std::size_t MapFusion::merge_changed() {
   std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> touched;
   for (Robot& robot : robots_) {
     if (robot.changed.empty()) continue;
+    std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> targets;
     for (const auto& key : robot.changed) {
       for (const auto& t : touched_blocks(key, params_, params_, robot.source.T_fused_robot)) {
-        touched.insert(t);
+        targets.insert(t);
       }
     }
     robot.changed.clear();
-    mapping::merge_into(fused_, robot.local, robot.source.T_fused_robot);
+    // The same as mapping::merge_into(fused_, robot.local, T) but resampling only the fused
+    // blocks the change reaches.
+    const std::vector<mapping::BlockIndex> list(targets.begin(), targets.end());
+    remerge_blocks(fused_, robot.id, robot.layer, params_, list, robot.source.T_fused_robot);
+    touched.insert(list.begin(), list.end());
     ++robot.counters.merges;
   }
   std::size_t handed = 0;
@@ -111,7 +116,7 @@ std::size_t MapFusion::spin_once(common::Stamp now) {
     any_changed = any_changed || !robot.changed.empty();
   }
   std::size_t handed = 0;
-  // Merging resamples whole layers, so it runs at the publication rate, not per sample.
+  // Merging at the publication rate resamples a block that changed several times once.
   if (any_changed && now >= next_merge_) {
     handed = merge_changed();
     next_merge_ = now + 1.0 / config_.output.blocks_hz;

@@ -3,9 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <random>
-
-#include "semap/mapping/map_merge.hpp"
 
 namespace semap::fusion {
 namespace {
@@ -16,10 +13,6 @@ dds_idl::MapDescription shape(float resolution, std::uint16_t cells, std::uint16
   d.block_cells = cells;
   d.num_classes = classes;
   return d;
-}
-
-bool contains(const std::vector<mapping::BlockIndex>& keys, const mapping::BlockIndex& k) {
-  return std::find(keys.begin(), keys.end(), k) != keys.end();
 }
 
 TEST(BlockLayers, ParamsFollowTheDescription) {
@@ -66,44 +59,6 @@ TEST(BlockLayers, EvidenceRoundTripsThroughALayeredMap) {
   EXPECT_FALSE(fused_snapshot(map, {5, 5, 5}, 1));
   auto plain = dds_idl::BlockSnapshot::empty({0, 0, 0}, 0.1f, 4, 3, false);
   EXPECT_THROW(evidence_block(plain, p), std::invalid_argument);
-}
-
-TEST(BlockLayers, TouchedBlocksOfAnAlignedShiftAreExact) {
-  const auto p = layered_params(shape(0.25f, 4, 2), mapping::MapMethod::kBki, 0.001);
-  EXPECT_EQ(touched_blocks({2, -1, 3}, p, p, Eigen::Isometry3d::Identity()),
-            (std::vector<mapping::BlockIndex>{{2, -1, 3}}));
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = Eigen::Vector3d(2.0, 0.0, -1.0);  // two blocks in x, one down
-  EXPECT_EQ(touched_blocks({0, 0, 0}, p, p, T), (std::vector<mapping::BlockIndex>{{2, 0, -1}}));
-  T.translation() = Eigen::Vector3d(0.5, 0.0, 0.0);  // half a block: two targets
-  EXPECT_EQ(touched_blocks({0, 0, 0}, p, p, T),
-            (std::vector<mapping::BlockIndex>{{0, 0, 0}, {1, 0, 0}}));
-}
-
-// Whatever the transform, every block that resample_layer writes from a source block is in
-// touched_blocks, so the fusion republishes every fused block a change reaches.
-TEST(BlockLayers, TouchedBlocksCoverWhatResamplingWrites) {
-  const auto p = layered_params(shape(0.2f, 4, 2), mapping::MapMethod::kBki, 0.001);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> angle(-3.2, 3.2);
-  std::uniform_real_distribution<double> shift(-5.0, 5.0);
-  for (int trial = 0; trial < 40; ++trial) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = (Eigen::AngleAxisd(angle(rng), Eigen::Vector3d::UnitZ()) *
-                  Eigen::AngleAxisd(angle(rng) / 4, Eigen::Vector3d::UnitY()))
-                     .toRotationMatrix();
-    T.translation() = Eigen::Vector3d(shift(rng), shift(rng), shift(rng));
-    const mapping::BlockIndex key{trial % 5 - 2, trial % 3, -1};
-    mapping::EvidenceGrid layer(p.block_side(), p.channels());
-    layer.put_block(key, mapping::EvidenceGrid::Block(layer.block_floats(), 1.0f));
-    const auto written = mapping::resample_layer(layer, p, p, T);
-    const auto touched = touched_blocks(key, p, p, T);
-    ASSERT_GT(written.size(), 0u);
-    for (const auto& [k, block] : written.blocks()) {
-      EXPECT_TRUE(contains(touched, k))
-          << "trial " << trial << " block " << k.x << "," << k.y << "," << k.z;
-    }
-  }
 }
 
 }  // namespace

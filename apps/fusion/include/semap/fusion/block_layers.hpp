@@ -1,6 +1,5 @@
 #pragma once
 
-#include <Eigen/Geometry>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -35,13 +34,5 @@ mapping::EvidenceGrid::Block evidence_block(const dds_idl::BlockSnapshot& block,
 std::optional<dds_idl::BlockSnapshot> fused_snapshot(const mapping::LayeredMap& map,
                                                      const mapping::BlockIndex& key,
                                                      std::uint32_t version);
-
-// Blocks of the target grid whose cells can take evidence from source block `key` when a
-// layer is resampled with T_to_from (mapping::resample_layer: a target cell takes the source
-// cell its centre falls in). A superset, exact for grid-aligned transforms.
-std::vector<mapping::BlockIndex> touched_blocks(const mapping::BlockIndex& key,
-                                                const mapping::LayeredMapParams& from,
-                                                const mapping::LayeredMapParams& to,
-                                                const Eigen::Isometry3d& T_to_from);
 
 }  // namespace semap::fusion

@@ -29,10 +29,11 @@ struct FusionCounters {
 
 // Follows several robots' maps over DDS and publishes their fusion. Each robot's received
 // blocks form that robot's evidence layer (source id = its position in the config + 1) in
-// its own map frame; at the publication rate the layers that changed are merged into the
-// fused map with mapping::merge_into, resampled by the robot's T_fused_robot, and the fused
-// blocks they touch are republished. mapping::LayeredMap keeps one layer per robot and a
-// changed layer replaces the previous copy, so the fused Dirichlet evidence is
+// its own map frame. At the publication rate every changed layer is merged into the fused
+// map as mapping::merge_into would, resampled by the robot's T_fused_robot, but only in the
+// fused blocks the changed blocks reach (remerge_blocks), and those fused blocks are
+// republished. mapping::LayeredMap keeps one layer per robot and a changed layer replaces
+// that robot's previous evidence, so the fused Dirichlet evidence is
 // alpha_0 + sum over robots of (alpha_r - alpha_0): every robot's evidence and the prior count
 // exactly once however often a block is resent.
 // Not thread safe: call from one thread.
@@ -56,7 +57,7 @@ class MapFusion {
     RobotSource source;
     mapping::SourceId id;
     std::unique_ptr<dds_idl::MapClient> client;
-    mapping::LayeredMap local;                 // the robot's layer in its own frame
+    mapping::EvidenceGrid layer;               // the robot's evidence in its own frame
     std::vector<mapping::BlockIndex> changed;  // since the last merge
     RobotCounters counters;
   };
