@@ -63,6 +63,12 @@ void DdsOutputs::publish_blocks(std::vector<dds_idl::BlockSnapshot>&& blocks, co
   map_publisher_.spin_once(now);
   std::lock_guard lock(map_counters_mutex_);
   map_counters_ = map_publisher_.counters();
+  map_pending_ = map_publisher_.pending();
+}
+
+std::size_t DdsOutputs::map_pending() const {
+  std::lock_guard lock(map_counters_mutex_);
+  return map_pending_;
 }
 
 dds_idl::MapPublisherCounters DdsOutputs::map_counters() const {

@@ -29,6 +29,8 @@ class DdsOutputs {
   std::uint64_t odometry_written() const { return odometry_written_.load(); }
   std::uint64_t health_written() const { return health_written_; }
   dds_idl::MapPublisherCounters map_counters() const;
+  // Changed blocks waiting for the next publication round.
+  std::size_t map_pending() const;
 
  private:
   const OnboardConfig& config_;
@@ -41,6 +43,7 @@ class DdsOutputs {
   dds_idl::MapPublisher map_publisher_;
   mutable std::mutex map_counters_mutex_;
   dds_idl::MapPublisherCounters map_counters_;
+  std::size_t map_pending_ = 0;
   std::uint64_t health_written_ = 0;  // main thread only
 };
 

@@ -90,8 +90,13 @@ std::vector<semap::onboard::StageFigures> stage_figures(
       {"perception", est.images_posed, depth(r.images), drops(r.images),
        estimation.image_latency().percentiles()},
       {"mapping", map.scans, depth(r.clouds), drops(r.clouds), mapping.latency().percentiles()},
-      // Blocks written; a "drop" is a round cut short by a slow reader (blocks stay pending).
-      {"dds_map", out.blocks_written, 0, out.write_timeouts, {}},
+      // Blocks written, blocks waiting for the next round; a "drop" is a round cut short by a
+      // slow reader (its blocks stay pending, nothing is lost).
+      {"dds_map",
+       out.blocks_written,
+       static_cast<std::uint32_t>(dds.map_pending()),
+       out.write_timeouts,
+       {}},
   };
 }
 
