@@ -64,5 +64,6 @@ grep '^health: ' "$work/listener.log" | awk '{ for (i = 1; i < NF; i++) if ($i =
 cloud_drops=$(sed -n 's/^ring drops .* clouds \([0-9]*\)$/\1/p' "$work/onboard.log")
 [[ -n "$map_drops" && -n "$cloud_drops" && "$map_drops" -le "$cloud_drops" ]] || {
   echo "mapping drops $map_drops vs cloud ring drops at exit '$cloud_drops'"; exit 1; }
+echo "e2e: last $health"
 echo "e2e: health ${reports} reports, estimation ${est_rate} Hz p50 ${est_p50} ms p99 ${est_p99} ms"
 echo "e2e: rmse ${rmse} m, ${scans} scans, listener ${blocks} blocks"
