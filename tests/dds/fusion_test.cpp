@@ -211,6 +211,15 @@ TEST_F(FusionTest, TwoRobotsWithAKnownOffsetFuseLikeTheMappingMerge) {
   for (std::size_t k = 0; k < kClasses; ++k) {
     EXPECT_NEAR(e[k], world_evidence(1, c, k) + world_evidence(2, c, k), 1e-4) << k;
   }
+  // What a planner's query answers there is what the mapping library says of the direct merge.
+  std::vector<float> alpha(kClasses);
+  ASSERT_TRUE(expected_.fused(c, alpha));
+  const auto summary = mapping::summarize(params_, alpha);
+  const dds_idl::CellQuery q = fused.query(overlap);
+  EXPECT_TRUE(q.known_block);
+  EXPECT_EQ(q.state, summary.occupied ? dds_idl::CellState::kOccupied : dds_idl::CellState::kFree);
+  EXPECT_EQ(q.cls, summary.label);
+  EXPECT_FLOAT_EQ(q.variance, summary.variance);
   // Robot2's blocks appear 10 m along x from where its own frame has them.
   const Eigen::Vector3f robot2_only(7.1f, 0.3f, 0.1f);  // world cell (35, 1, 0)
   const auto e2 = evidence_at(fused, robot2_only);
