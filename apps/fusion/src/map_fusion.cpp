@@ -84,7 +84,7 @@ std::size_t MapFusion::merge_changed() {
       }
     }
     robot.changed.clear();
-    // The same as mapping::merge_into(fused_, robot.local, T) but resampling only the fused
+    // The same as mapping::merge_into of the robot's whole layer, but resampling only the fused
     // blocks the change reaches.
     const std::vector<mapping::BlockIndex> list(targets.begin(), targets.end());
     remerge_blocks(fused_, robot.id, robot.layer, params_, list, robot.source.T_fused_robot);
