@@ -1,6 +1,7 @@
 // semap-dds-sim-pub: a stand-in robot for demos and manual checks. Publishes odometry along a
 // circle and a growing synthetic semantic map, so listeners, RViz or ros2 topic echo have
 // something to show before the real pipeline runs.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -16,25 +17,35 @@ namespace sd = semap::dds_idl;
 
 namespace {
 
-// A floor of class 1 under the robot's path, with walls of class 2 at its edge.
+// Dirichlet prior the synthetic evidence assumes (semap-fusion's default `prior`).
+constexpr float kPrior = 0.001f;
+
+// A floor of class 1 under the robot's path, with walls of class 2 at its edge, the rest free
+// (class 0). Each version adds one observation of every cell's class to its evidence (alpha
+// minus the prior, as the mapping stage publishes it), so fusion has evidence to merge.
 sd::BlockSnapshot synthetic_block(sd::BlockIndex index, const sd::MapDescription& d,
                                   std::uint32_t version) {
   sd::BlockSnapshot b =
-      sd::BlockSnapshot::empty(index, d.resolution, d.block_cells, d.num_classes, false);
+      sd::BlockSnapshot::empty(index, d.resolution, d.block_cells, d.num_classes, true);
   b.version = version;
+  const auto k = static_cast<std::size_t>(d.num_classes);
+  const auto observations = static_cast<float>(version);
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
     const Eigen::Vector3f c = b.cell_center(i);
     const float r = c.head<2>().norm();
+    std::uint16_t cls = 0;
     if (c.z() < d.resolution) {
-      b.state[i] = sd::CellState::kOccupied;
-      b.argmax_class[i] = 1;
+      cls = 1;
     } else if (std::fabs(r - 10.0f) < d.resolution && c.z() < 2.0f) {
-      b.state[i] = sd::CellState::kOccupied;
-      b.argmax_class[i] = static_cast<std::uint16_t>(std::min<int>(2, d.num_classes - 1));
-    } else {
-      b.state[i] = sd::CellState::kFree;
+      cls = static_cast<std::uint16_t>(std::min<int>(2, d.num_classes - 1));
     }
-    b.variance[i] = 0.01f / static_cast<float>(version);
+    b.state[i] = cls == 0 ? sd::CellState::kFree : sd::CellState::kOccupied;
+    b.argmax_class[i] = cls;
+    b.evidence[i * k + cls] = observations;
+    // Dirichlet variance of the argmax class' probability.
+    const float a = kPrior + observations;
+    const float sum = static_cast<float>(k) * kPrior + observations;
+    b.variance[i] = a * (sum - a) / (sum * sum * (sum + 1.0f));
   }
   return b;
 }

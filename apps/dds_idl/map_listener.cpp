@@ -7,10 +7,31 @@
 #include "dds_app.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/dds_idl/converters.hpp"
+#include "semap/dds_idl/health.hpp"
 #include "semap/dds_idl/map_client.hpp"
 #include "semap/dds_idl/topic_names.hpp"
 
 namespace sd = semap::dds_idl;
+
+namespace {
+
+// One line per Health sample, "health: <stage> rate .. | driver <name> frames ..", for people
+// and for the end-to-end test to parse.
+void print_health(const sd::HealthReport& h) {
+  std::cout << "health:";
+  for (const auto& s : h.stages) {
+    std::cout << " stage " << s.name << " rate " << s.rate_hz << " depth " << s.queue_depth
+              << " drops " << s.drops << " p50 " << s.latency_p50_ms << " p99 " << s.latency_p99_ms
+              << " |";
+  }
+  for (const auto& d : h.drivers) {
+    std::cout << " driver " << d.name << " frames " << d.frames << " bad " << d.bad_frames
+              << " dropped " << d.dropped << " reconnects " << d.reconnects << " |";
+  }
+  std::cout << std::endl;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app("Prints the semantic map and pose a robot publishes over DDS");
@@ -21,12 +42,14 @@ int main(int argc, char** argv) {
   double seconds = 0.0;
   std::size_t expect_blocks = 0;
   int num_classes = 0;
+  bool health = false;
   app.add_option("--config", config_path, "semap YAML; its dds: section is used")
       ->check(CLI::ExistingFile);
   app.add_option("--save", save_path, "write the received map as PCD (x y z class variance)");
   app.add_option("--seconds", seconds, "stop after this long (0: until Ctrl-C)");
   app.add_option("--expect-blocks", expect_blocks, "stop once this many blocks arrived");
   app.add_option("--classes", num_classes, "reject blocks with another class count");
+  app.add_flag("--health", health, "also print the robot's health reports");
   CLI11_PARSE(app, argc, argv);
   semap::common::setup_logging();
 
@@ -46,6 +69,13 @@ int main(int argc, char** argv) {
     sd::Reader<sd::msg::Odometry> odom(participant, odom_topic,
                                        sd::topic_qos(sd::SemapTopic::kOdometry));
 
+    std::optional<sd::Topic<sd::msg::Health>> health_topic;
+    std::optional<sd::Reader<sd::msg::Health>> health_reader;
+    if (health) {
+      health_topic.emplace(participant, sd::topic_name(dds.settings().ns, sd::SemapTopic::kHealth));
+      health_reader.emplace(participant, *health_topic, sd::topic_qos(sd::SemapTopic::kHealth));
+    }
+
     std::cout << "listening on " << sd::topic_name(dds.settings().ns, sd::SemapTopic::kMapBlocks)
               << " (domain " << dds.settings().domain << ")" << std::endl;
     const auto start = std::chrono::steady_clock::now();
@@ -57,6 +87,11 @@ int main(int argc, char** argv) {
       odom.take_each([&](const sd::msg::Odometry& m, const dds_sample_info_t&) {
         last_pose = sd::from_msg(m);
       });
+      if (health_reader) {
+        health_reader->take_each([](const sd::msg::Health& m, const dds_sample_info_t&) {
+          print_health(sd::from_msg(m));
+        });
+      }
       const auto now = std::chrono::steady_clock::now();
       if (client.counters().infos != info_seen && client.info()) {
         info_seen = client.counters().infos;

@@ -27,6 +27,9 @@ DdsOutputs::DdsOutputs(const OnboardConfig& config)
                       dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
       odometry_writer_(participant_, odometry_topic_,
                        dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
+      health_topic_(participant_, dds_idl::topic_name(config.dds.ns, dds_idl::SemapTopic::kHealth),
+                    dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
+      health_writer_(participant_, health_topic_, dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
       map_publisher_(participant_,
                      dds_idl::MapPublisherConfig{config.dds.ns, config.dds.frame_id,
                                                  config.dds.publish_hz, config.dds.cloud_hz},
@@ -49,11 +52,23 @@ void DdsOutputs::publish_pose(const PoseOutput& pose) {
   odometry_written_.fetch_add(1);
 }
 
+void DdsOutputs::publish_health(const dds_idl::HealthReport& report) {
+  const dds_idl::HealthMessage m(report, config_.dds.frame_id);
+  health_writer_.write(m.get());
+  ++health_written_;
+}
+
 void DdsOutputs::publish_blocks(std::vector<dds_idl::BlockSnapshot>&& blocks, common::Stamp now) {
   for (auto& b : blocks) map_publisher_.update(std::move(b));
   map_publisher_.spin_once(now);
   std::lock_guard lock(map_counters_mutex_);
   map_counters_ = map_publisher_.counters();
+  map_pending_ = map_publisher_.pending();
+}
+
+std::size_t DdsOutputs::map_pending() const {
+  std::lock_guard lock(map_counters_mutex_);
+  return map_pending_;
 }
 
 dds_idl::MapPublisherCounters DdsOutputs::map_counters() const {

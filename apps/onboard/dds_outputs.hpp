@@ -6,6 +6,7 @@
 
 #include "estimation_stage.hpp"
 #include "onboard_config.hpp"
+#include "semap/dds_idl/health.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/dds_idl/participant.hpp"
 #include "semap/dds_idl/topic.hpp"
@@ -22,9 +23,14 @@ class DdsOutputs {
 
   void publish_pose(const PoseOutput& pose);
   void publish_blocks(std::vector<dds_idl::BlockSnapshot>&& blocks, common::Stamp now);
+  // From the main thread, at 1 Hz.
+  void publish_health(const dds_idl::HealthReport& report);
 
   std::uint64_t odometry_written() const { return odometry_written_.load(); }
+  std::uint64_t health_written() const { return health_written_; }
   dds_idl::MapPublisherCounters map_counters() const;
+  // Changed blocks waiting for the next publication round.
+  std::size_t map_pending() const;
 
  private:
   const OnboardConfig& config_;
@@ -32,9 +38,13 @@ class DdsOutputs {
   dds_idl::Topic<dds_idl::msg::Odometry> odometry_topic_;
   dds_idl::Writer<dds_idl::msg::Odometry> odometry_writer_;
   std::atomic<std::uint64_t> odometry_written_{0};
+  dds_idl::Topic<dds_idl::msg::Health> health_topic_;
+  dds_idl::Writer<dds_idl::msg::Health> health_writer_;
   dds_idl::MapPublisher map_publisher_;
   mutable std::mutex map_counters_mutex_;
   dds_idl::MapPublisherCounters map_counters_;
+  std::size_t map_pending_ = 0;
+  std::uint64_t health_written_ = 0;  // main thread only
 };
 
 // Class names and colours of the built-in world, for MapInfo.

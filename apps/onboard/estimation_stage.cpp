@@ -69,6 +69,12 @@ bool EstimationStage::drain_sensors() {
       ++local_.imu_samples;
     }
   }
+  if (n_imu > 0) {
+    const common::Stamp done = common::Stamp::now();
+    for (std::size_t k = 0; k < n_imu; ++k) {
+      imu_latency_.record(common::seconds_between(done, imu_batch[k].stamp));
+    }
+  }
   mapping::LabeledDepthImage image;
   while (image_ring_.try_pop(image)) {
     pending_images_.push_back(std::move(image));
@@ -96,6 +102,7 @@ void EstimationStage::pose_images() {
                                        config_.camera.max_range);
     cloud.num_classes = static_cast<std::uint16_t>(config_.map.num_classes);
     cloud_ring_.try_push(std::move(cloud));
+    image_latency_.record(common::seconds_between(common::Stamp::now(), image.stamp));
     ++local_.images_posed;
     pending_images_.pop_front();
   }

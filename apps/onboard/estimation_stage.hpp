@@ -6,6 +6,7 @@
 #include <optional>
 #include <thread>
 
+#include "latency_window.hpp"
 #include "onboard_config.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
@@ -54,6 +55,10 @@ class EstimationStage {
   void start();
   void stop();
   EstimationStageStats stats() const;
+  // Age of each IMU sample when the filter has taken it (driver stamp to filter).
+  const LatencyWindow& imu_latency() const { return imu_latency_; }
+  // Age of each image when its posed cloud goes to the mapping stage.
+  const LatencyWindow& image_latency() const { return image_latency_; }
 
  private:
   void run(std::stop_token stop);
@@ -76,6 +81,8 @@ class EstimationStage {
   EstimationStageStats local_;
   mutable std::mutex stats_mutex_;
   EstimationStageStats shared_;
+  LatencyWindow imu_latency_;
+  LatencyWindow image_latency_;
   std::jthread thread_;
 };
 

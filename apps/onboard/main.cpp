@@ -11,6 +11,7 @@
 
 #include "dds_outputs.hpp"
 #include "estimation_stage.hpp"
+#include "health_monitor.hpp"
 #include "mapping_stage.hpp"
 #include "onboard_config.hpp"
 #include "semap/common/config.hpp"
@@ -60,6 +61,45 @@ class LiveAccuracy {
   std::size_t count_ = 0;
 };
 
+// Rings feeding each stage, for the health report.
+struct Rings {
+  SpscRing<semap::common::ImuSample>& imu;
+  SpscRing<semap::common::GnssFix>& gnss;
+  SpscRing<semap::mapping::LabeledDepthImage>& images;
+  SpscRing<semap::common::LabeledCloud>& clouds;
+};
+
+template <typename... R>
+std::uint32_t depth(const R&... rings) {
+  return static_cast<std::uint32_t>((rings.size() + ...));
+}
+template <typename... R>
+std::uint64_t drops(const R&... rings) {
+  return (rings.counters().drops() + ...);
+}
+
+std::vector<semap::onboard::StageFigures> stage_figures(
+    const Rings& r, const semap::onboard::EstimationStage& estimation,
+    const semap::onboard::MappingStage& mapping, const semap::onboard::DdsOutputs& dds) {
+  const auto est = estimation.stats();
+  const auto map = mapping.stats();
+  const auto out = dds.map_counters();
+  return {
+      {"estimation", est.imu_samples, depth(r.imu, r.gnss), drops(r.imu, r.gnss),
+       estimation.imu_latency().percentiles()},
+      {"perception", est.images_posed, depth(r.images), drops(r.images),
+       estimation.image_latency().percentiles()},
+      {"mapping", map.scans, depth(r.clouds), drops(r.clouds), mapping.latency().percentiles()},
+      // Blocks written, blocks waiting for the next round; a "drop" is a round cut short by a
+      // slow reader (its blocks stay pending, nothing is lost).
+      {"dds_map",
+       out.blocks_written,
+       static_cast<std::uint32_t>(dds.map_pending()),
+       out.write_timeouts,
+       {}},
+  };
+}
+
 int run(const semap::onboard::OnboardConfig& config) {
   using namespace semap;
   auto log = common::logger("onboard");
@@ -108,11 +148,23 @@ int run(const semap::onboard::OnboardConfig& config) {
   LiveAccuracy accuracy;
   const auto started = common::Stamp::now();
   auto next_report = started + 5.0;
+  const Rings rings{imu_ring, gnss_ring, image_ring, cloud_ring};
+  onboard::HealthMonitor health;
+  auto next_health = started;
   while (!g_stop.load()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const auto est = estimation_stage.stats();
     if (rig) accuracy.sample(*rig, est);
     const auto now = common::Stamp::now();
+    if (dds && now >= next_health) {
+      next_health = now + 1.0;
+      std::vector<dds_idl::DriverCountersData> driver_counters;
+      if (gnss_driver)
+        driver_counters.push_back(onboard::driver_health("gnss", gnss_driver->stats()));
+      if (imu_driver) driver_counters.push_back(onboard::driver_health("imu", imu_driver->stats()));
+      dds->publish_health(health.report(
+          now, stage_figures(rings, estimation_stage, mapping_stage, *dds), driver_counters));
+    }
     if (now >= next_report) {
       next_report = now + 5.0;
       const auto map = mapping_stage.stats();
@@ -177,9 +229,12 @@ int run(const semap::onboard::OnboardConfig& config) {
     const auto m = dds->map_counters();
     std::printf(
         "dds              : %lu odometry samples, %lu block samples in %lu rounds, "
-        "%lu map clouds\n",
-        dds->odometry_written(), m.blocks_written, m.block_publications, m.clouds_written);
+        "%lu map clouds, %lu health reports\n",
+        dds->odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
+        dds->health_written());
   }
+  std::printf("ring drops       : imu %lu, gnss %lu, images %lu, clouds %lu\n", drops(imu_ring),
+              drops(gnss_ring), drops(image_ring), drops(cloud_ring));
   // Without a camera (hardware rig today) an empty map is expected; a filter that never
   // initialised is a failure either way.
   const bool mapped = !rig || map.scans > 0;

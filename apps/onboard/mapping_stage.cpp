@@ -80,6 +80,7 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   const auto result = map_.insert(cloud, cloud.origin);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
   auto snapshots = snapshots_of(result.updated_blocks);
   local_.scans++;
   local_.points += cloud.size();

@@ -6,6 +6,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "latency_window.hpp"
 #include "onboard_config.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
@@ -38,6 +39,8 @@ class MappingStage {
   void start();
   void stop();
   MappingStageStats stats() const;
+  // Age of each cloud (its image's capture stamp) once it is in the map.
+  const LatencyWindow& latency() const { return latency_; }
   // Only after stop(): the map belongs to the stage thread while it runs.
   const mapping::SemanticMap& map() const { return map_; }
 
@@ -54,6 +57,7 @@ class MappingStage {
   MappingStageStats local_;
   mutable std::mutex stats_mutex_;
   MappingStageStats shared_;
+  LatencyWindow latency_;
   std::jthread thread_;
 };
 

@@ -27,6 +27,7 @@ TEST_F(DdsTest, SimulatedRobotsFusionAndListenerWorkTogether) {
     std::ofstream yaml(dir / "fusion.yaml");
     yaml << "dds: { domain: " << test_domain() << " }\n"
          << "fusion:\n  robots: [" << r1 << ", " << r2 << "]\n  output: " << fused
+         << "\n  transforms: { " << r2 << ": [40, 0, 0, 0, 0, 0] }"
          << "\n  publish_hz: 10\n  resolution: 0.1\n  block_cells: 8\n  num_classes: 4\n";
   }
   ChildProcess robot1(app("semap-dds-sim-pub", {"--ns", r1, "--seconds", "20"}));
@@ -36,22 +37,31 @@ TEST_F(DdsTest, SimulatedRobotsFusionAndListenerWorkTogether) {
   ASSERT_TRUE(fusion.expect("fusing 2 robots", seconds(10)));
 
   const fs::path pcd = dir / "fused.pcd";
-  ChildProcess listener(app("semap-map-listener", {"--ns", fused, "--expect-blocks", "9",
-                                                   "--seconds", "15", "--save", pcd.string()}));
+  // Both robots drive the same circle around their own origin; robot2's map frame sits 40 m
+  // along x in the fused frame, so the fused map must hold two separate circles.
+  ChildProcess listener(
+      app("semap-map-listener", {"--ns", fused, "--seconds", "6", "--save", pcd.string()}));
   const auto final_line = listener.expect("final:", seconds(20));
   ASSERT_TRUE(final_line);
   EXPECT_NE(final_line->find("rejected 0"), std::string::npos) << *final_line;
   EXPECT_EQ(listener.wait(), 0);
   std::ifstream in(pcd);
   std::string line;
-  std::size_t points = 0;
+  std::size_t points = 0, near_origin = 0, shifted = 0;
   bool data = false;
   while (std::getline(in, line)) {
-    if (data) ++points;
+    if (data) {
+      ++points;
+      const double x = std::stod(line);
+      near_origin += x > -12.0 && x < 12.0;
+      shifted += x > 28.0 && x < 52.0;
+    }
     if (line == "DATA ascii") data = true;
   }
-  // Nine 8^3 blocks with a floor layer of 8 x 8 occupied cells each.
-  EXPECT_GE(points, 9u * 64u);
+  // At least nine 8^3 blocks per robot, each with a floor layer of 8 x 8 occupied cells.
+  EXPECT_GE(near_origin, 9u * 64u);
+  EXPECT_GE(shifted, 9u * 64u);
+  EXPECT_EQ(near_origin + shifted, points);
   fs::remove_all(dir);
 }
 

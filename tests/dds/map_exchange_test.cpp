@@ -6,7 +6,6 @@
 
 #include "dds_fixture.hpp"
 #include "semap/dds_idl/map_client.hpp"
-#include "semap/dds_idl/map_fusion.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "test_blocks.hpp"
 
@@ -145,52 +144,6 @@ TEST_F(DdsTest, PublisherSendsOnlyChangedBlocksAtItsRate) {
   EXPECT_THAT(client.take_changed(),
               ::testing::UnorderedElementsAre(grid_index(1), grid_index(2), grid_index(3)));
   EXPECT_THROW(pub.update(make_block({0, 0, 0}, 1, 4, false)), std::invalid_argument);
-}
-
-TEST_F(DdsTest, FusionMergesEvidenceOfTwoRobots) {
-  const std::string a = unique_ns("robot_a");
-  const std::string b = unique_ns("robot_b");
-  ChildProcess pub_a(peer("map-pub", {"--ns", a, "--blocks", "30", "--classes", "4", "--version",
-                                      "1", "--evidence", "--seconds", "30"}));
-  ChildProcess pub_b(peer("map-pub", {"--ns", b, "--blocks", "30", "--classes", "4", "--version",
-                                      "2", "--evidence", "--seconds", "30"}));
-  ASSERT_TRUE(pub_a.expect("published 30", seconds(10)));
-  ASSERT_TRUE(pub_b.expect("published 30", seconds(10)));
-
-  Participant participant(test_domain());
-  MapFusionConfig cfg;
-  cfg.robots = {a, b};
-  cfg.output.ns = unique_ns("fused");
-  cfg.output.blocks_hz = 20.0;
-  cfg.description = test_description(4);
-  MapFusion fusion(participant, cfg);
-  MapClient fused(participant, {cfg.output.ns, {}});
-
-  // A block merged before the other robot's copy arrived is merged again later; wait for the
-  // versions of both (1 + 2).
-  const auto all_merged = [&] {
-    if (fused.blocks().size() < 30) return false;
-    for (const auto& [index, block] : fused.blocks()) {
-      if (block.version != 3) return false;
-    }
-    return true;
-  };
-  const auto deadline = std::chrono::steady_clock::now() + seconds(15);
-  while (!all_merged() && std::chrono::steady_clock::now() < deadline) {
-    fusion.spin_once(Stamp::now());
-    fused.wait_for_blocks(30, milliseconds(50));
-  }
-  ASSERT_EQ(fusion.robot(0).blocks().size(), 30u);
-  ASSERT_EQ(fusion.robot(1).blocks().size(), 30u);
-  ASSERT_EQ(fused.blocks().size(), 30u);
-  for (const auto& [index, block] : fused.blocks()) {
-    const BlockSnapshot ea = make_block(index, 1, 4, true);
-    const BlockSnapshot eb = make_block(index, 2, 4, true);
-    ASSERT_EQ(block.evidence.size(), ea.evidence.size());
-    for (std::size_t i = 0; i < ea.evidence.size(); ++i) {
-      ASSERT_FLOAT_EQ(block.evidence[i], ea.evidence[i] + eb.evidence[i]);
-    }
-  }
 }
 
 }  // namespace

@@ -28,8 +28,8 @@ struct BlockIndexHash {
 
 // One block of the semantic map as the map publishes it: the plain C++ form of
 // semap_msgs/SemanticMapBlock, independent of the mapping library. Cells are ordered x fastest,
-// then y, then z. `evidence` is empty or holds cell_count() * num_classes Dirichlet
-// concentration parameters, cell-major.
+// then y, then z. `evidence` is empty or holds cell_count() * num_classes Dirichlet evidence
+// values alpha - alpha_0 (the prior left out, as the mapping library stores them), cell-major.
 struct BlockSnapshot {
   BlockIndex index;
   float resolution = 0.1f;        // cell edge, m

@@ -1,0 +1,72 @@
+#include "semap/fusion/block_layers.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <stdexcept>
+#include <string>
+
+#include "semap/mapping/cell_summary.hpp"
+
+namespace semap::fusion {
+
+mapping::LayeredMapParams layered_params(const dds_idl::MapDescription& description,
+                                         mapping::MapMethod method, double prior) {
+  if (method == mapping::MapMethod::kLogOdds) {
+    throw std::invalid_argument("fusion: DDS map blocks carry Dirichlet evidence (bki or csm)");
+  }
+  const unsigned cells = description.block_cells;
+  if (!std::has_single_bit(cells)) {
+    throw std::invalid_argument("fusion: block_cells " + std::to_string(cells) +
+                                " is not a power of two (the mapping library's blocks are)");
+  }
+  mapping::LayeredMapParams p;
+  p.method = method;
+  p.resolution = static_cast<double>(description.resolution);
+  p.block_depth = std::countr_zero(cells) + 1;
+  p.num_classes = description.num_classes;
+  p.prior = prior;
+  mapping::validate(p);
+  return p;
+}
+
+mapping::EvidenceGrid::Block evidence_block(const dds_idl::BlockSnapshot& block,
+                                            const mapping::LayeredMapParams& params) {
+  if (block.block_cells != params.block_side() || block.num_classes != params.num_classes ||
+      block.evidence.size() != block.cell_count() * block.num_classes) {
+    throw std::invalid_argument(
+        "fusion: block (" + std::to_string(block.index.x) + ", " + std::to_string(block.index.y) +
+        ", " + std::to_string(block.index.z) + ") has no evidence or differs from the map's shape");
+  }
+  return {block.evidence.begin(), block.evidence.end()};
+}
+
+std::optional<dds_idl::BlockSnapshot> fused_snapshot(const mapping::LayeredMap& map,
+                                                     const mapping::BlockIndex& key,
+                                                     std::uint32_t version) {
+  std::vector<float> alpha;
+  if (!map.fused_block(key, alpha)) return std::nullopt;
+  const mapping::LayeredMapParams& p = map.params();
+  const auto k = static_cast<std::size_t>(p.num_classes);
+  auto snap = dds_idl::BlockSnapshot::empty(to_dds(key), static_cast<float>(p.resolution),
+                                            static_cast<std::uint16_t>(p.block_side()),
+                                            static_cast<std::uint16_t>(p.num_classes), true);
+  snap.version = version;
+  const auto prior = static_cast<float>(p.prior);
+  for (std::size_t cell = 0; cell < snap.cell_count(); ++cell) {
+    const std::span<const float> fused(alpha.data() + cell * k, k);
+    const mapping::CellSummary s = mapping::summarize(p, fused);
+    snap.state[cell] = !s.known     ? dds_idl::CellState::kUnknown
+                       : s.occupied ? dds_idl::CellState::kOccupied
+                                    : dds_idl::CellState::kFree;
+    snap.argmax_class[cell] = static_cast<std::uint16_t>(s.label);
+    snap.variance[cell] = s.variance;
+    // Published as increments like the robots' blocks, so a fused map can be fused again;
+    // the clamp only absorbs the rounding of (alpha_0 + e) - alpha_0.
+    for (std::size_t c = 0; c < k; ++c) {
+      snap.evidence[cell * k + c] = std::max(fused[c] - prior, 0.0f);
+    }
+  }
+  return snap;
+}
+
+}  // namespace semap::fusion

@@ -1,0 +1,118 @@
+#include "semap/fusion/incremental_merge.hpp"
+
+#include <cmath>
+#include <unordered_set>
+
+#include "semap/mapping/grid_index.hpp"
+#include "semap/mapping/map_merge.hpp"
+
+namespace semap::fusion {
+
+namespace {
+
+// Rounding margin in cells: widening a range only adds blocks, never drops a boundary one.
+constexpr double kMargin = 1e-6;
+
+struct Box {
+  Eigen::Vector3d min = Eigen::Vector3d::Constant(1e300);
+  Eigen::Vector3d max = Eigen::Vector3d::Constant(-1e300);
+};
+
+// Bounding box of the transformed axis-aligned box [lo, hi].
+Box transformed_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                    const Eigen::Isometry3d& T) {
+  Box box;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d q =
+        T * Eigen::Vector3d((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(),
+                            (corner & 4) ? hi.z() : lo.z());
+    box.min = box.min.cwiseMin(q);
+    box.max = box.max.cwiseMax(q);
+  }
+  return box;
+}
+
+std::vector<mapping::BlockIndex> blocks_between(const mapping::CellIndex& first,
+                                                const mapping::CellIndex& last, int side) {
+  std::vector<mapping::BlockIndex> out;
+  if ((last.array() < first.array()).any()) return out;
+  const mapping::BlockIndex b0 = mapping::block_of_cell(first, side);
+  const mapping::BlockIndex b1 = mapping::block_of_cell(last, side);
+  for (int z = b0.z; z <= b1.z; ++z) {
+    for (int y = b0.y; y <= b1.y; ++y) {
+      for (int x = b0.x; x <= b1.x; ++x) out.push_back({x, y, z});
+    }
+  }
+  return out;
+}
+
+Eigen::Vector3d block_origin(const mapping::BlockIndex& key, const mapping::LayeredMapParams& p) {
+  return Eigen::Vector3d(key.x, key.y, key.z) * p.block_size();
+}
+
+}  // namespace
+
+std::vector<mapping::BlockIndex> touched_blocks(const mapping::BlockIndex& key,
+                                                const mapping::LayeredMapParams& from,
+                                                const mapping::LayeredMapParams& to,
+                                                const Eigen::Isometry3d& T_to_from) {
+  const Eigen::Vector3d lo = block_origin(key, from);
+  const Box box = transformed_box(lo, lo + Eigen::Vector3d::Constant(from.block_size()), T_to_from);
+  // Target cells whose centre lies in [box.min, box.max).
+  const auto first = [&](double v) {
+    return static_cast<int>(std::ceil(v / to.resolution - 0.5 - kMargin));
+  };
+  const auto last = [&](double v) {
+    return static_cast<int>(std::ceil(v / to.resolution - 0.5 + kMargin)) - 1;
+  };
+  return blocks_between({first(box.min.x()), first(box.min.y()), first(box.min.z())},
+                        {last(box.max.x()), last(box.max.y()), last(box.max.z())}, to.block_side());
+}
+
+std::vector<mapping::BlockIndex> source_blocks(const mapping::BlockIndex& key,
+                                               const mapping::LayeredMapParams& from,
+                                               const mapping::LayeredMapParams& to,
+                                               const Eigen::Isometry3d& T_to_from) {
+  // The target block's cell centres span the block shrunk by half a cell on every side.
+  const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * to.resolution);
+  const Eigen::Vector3d lo = block_origin(key, to) + half;
+  const Eigen::Vector3d hi =
+      block_origin(key, to) + Eigen::Vector3d::Constant(to.block_size()) - half;
+  const Box box = transformed_box(lo, hi, T_to_from.inverse());
+  const auto first = [&](double v) {
+    return static_cast<int>(std::floor(v / from.resolution - kMargin));
+  };
+  const auto last = [&](double v) {
+    return static_cast<int>(std::floor(v / from.resolution + kMargin));
+  };
+  return blocks_between({first(box.min.x()), first(box.min.y()), first(box.min.z())},
+                        {last(box.max.x()), last(box.max.y()), last(box.max.z())},
+                        from.block_side());
+}
+
+void remerge_blocks(mapping::LayeredMap& fused, mapping::SourceId source,
+                    const mapping::EvidenceGrid& layer, const mapping::LayeredMapParams& from,
+                    const std::vector<mapping::BlockIndex>& targets,
+                    const Eigen::Isometry3d& T_to_from) {
+  const mapping::LayeredMapParams& to = fused.params();
+  mapping::EvidenceGrid needed(layer.block_side(), layer.channels());
+  std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> taken;
+  for (const auto& target : targets) {
+    for (const auto& key : source_blocks(target, from, to, T_to_from)) {
+      if (!taken.insert(key).second) continue;
+      if (const auto* block = layer.find_block(key)) needed.put_block(key, *block);
+    }
+  }
+  mapping::EvidenceGrid rebuilt = mapping::resample_layer(needed, from, to, T_to_from);
+  mapping::EvidenceGrid& out = fused.layer(source);
+  for (const auto& target : targets) {
+    if (auto block = rebuilt.take_block(target)) {
+      out.put_block(target, std::move(*block));
+    } else {
+      out.take_block(target);
+    }
+  }
+  out.set_updates(layer.updates());
+}
+
+}  // namespace semap::fusion

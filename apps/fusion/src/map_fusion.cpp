@@ -1,0 +1,128 @@
+#include "semap/fusion/map_fusion.hpp"
+
+#include <chrono>
+#include <stdexcept>
+#include <unordered_set>
+
+#include "semap/common/logging.hpp"
+#include "semap/fusion/block_layers.hpp"
+#include "semap/fusion/incremental_merge.hpp"
+
+namespace semap::fusion {
+
+namespace {
+
+dds_idl::MapClientConfig client_config(const std::string& ns, const dds_idl::MapDescription& d) {
+  dds_idl::MapClientConfig c;
+  c.ns = ns;
+  c.limits.resolution = d.resolution;
+  c.limits.block_cells = d.block_cells;
+  c.limits.num_classes = d.num_classes;
+  return c;
+}
+
+}  // namespace
+
+MapFusion::MapFusion(const dds_idl::Participant& participant, MapFusionConfig config)
+    : config_(std::move(config)),
+      params_(layered_params(config_.description, config_.method, config_.prior)),
+      fused_(params_),
+      publisher_(participant, config_.output, config_.description) {
+  if (config_.robots.empty()) throw std::invalid_argument("MapFusion: no robots to follow");
+  robots_.reserve(config_.robots.size());
+  for (std::size_t i = 0; i < config_.robots.size(); ++i) {
+    const RobotSource& source = config_.robots[i];
+    if (source.ns == config_.output.ns) {
+      throw std::invalid_argument("MapFusion: output namespace '" + source.ns +
+                                  "' is also an input");
+    }
+    robots_.push_back(Robot{source,
+                            static_cast<mapping::SourceId>(i + 1),
+                            std::make_unique<dds_idl::MapClient>(
+                                participant, client_config(source.ns, config_.description)),
+                            mapping::EvidenceGrid(params_.block_side(), params_.channels()),
+                            {},
+                            {}});
+  }
+}
+
+void MapFusion::take_blocks(Robot& robot) {
+  robot.client->poll();
+  const std::vector<dds_idl::BlockIndex> changed = robot.client->take_changed();
+  if (changed.empty()) return;
+  mapping::EvidenceGrid& layer = robot.layer;
+  const std::size_t before = robot.changed.size();
+  for (const dds_idl::BlockIndex& index : changed) {
+    const dds_idl::BlockSnapshot& block = robot.client->blocks().at(index);
+    if (!block.has_evidence()) {
+      // Only argmax and variance: nothing the Dirichlet merge could add without guessing.
+      if (robot.counters.blocks_without_evidence++ == 0) {
+        common::logger("fusion")->warn(
+            "{}: block ({}, {}, {}) carries no evidence; such blocks are not fused",
+            robot.source.ns, index.x, index.y, index.z);
+      }
+      continue;
+    }
+    const mapping::BlockIndex key = to_mapping(index);
+    layer.put_block(key, evidence_block(block, params_));
+    robot.changed.push_back(key);
+    ++robot.counters.blocks;
+  }
+  // The update count orders copies of a layer, as in the mapping library (merge_into, .smap).
+  if (robot.changed.size() > before) layer.set_updates(layer.updates() + 1);
+}
+
+std::size_t MapFusion::merge_changed() {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> touched;
+  for (Robot& robot : robots_) {
+    if (robot.changed.empty()) continue;
+    std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> targets;
+    for (const auto& key : robot.changed) {
+      for (const auto& t : touched_blocks(key, params_, params_, robot.source.T_fused_robot)) {
+        targets.insert(t);
+      }
+    }
+    robot.changed.clear();
+    // The same as mapping::merge_into of the robot's whole layer, but resampling only the fused
+    // blocks the change reaches.
+    const std::vector<mapping::BlockIndex> list(targets.begin(), targets.end());
+    remerge_blocks(fused_, robot.id, robot.layer, params_, list, robot.source.T_fused_robot);
+    touched.insert(list.begin(), list.end());
+    ++robot.counters.merges;
+  }
+  std::size_t handed = 0;
+  for (const auto& key : touched) {
+    auto& version = versions_[key];
+    auto block = fused_snapshot(fused_, key, version + 1);
+    if (!block) continue;
+    ++version;
+    publisher_.update(std::move(*block));
+    ++handed;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++counters_.merge_rounds;
+  counters_.blocks_fused += handed;
+  counters_.merge_seconds_total += seconds;
+  counters_.merge_seconds_max = std::max(counters_.merge_seconds_max, seconds);
+  return handed;
+}
+
+std::size_t MapFusion::spin_once(common::Stamp now) {
+  bool any_changed = false;
+  for (Robot& robot : robots_) {
+    take_blocks(robot);
+    any_changed = any_changed || !robot.changed.empty();
+  }
+  std::size_t handed = 0;
+  // Merging at the publication rate resamples a block that changed several times once.
+  if (any_changed && now >= next_merge_) {
+    handed = merge_changed();
+    next_merge_ = now + 1.0 / config_.output.blocks_hz;
+  }
+  publisher_.spin_once(now);
+  return handed;
+}
+
+}  // namespace semap::fusion

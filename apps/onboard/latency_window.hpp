@@ -1,0 +1,31 @@
+#pragma once
+
+#include <cstddef>
+#include <mutex>
+#include <vector>
+
+namespace semap::onboard {
+
+struct LatencyPercentiles {
+  float p50_ms = 0.0f;
+  float p99_ms = 0.0f;
+  std::size_t count = 0;  // latencies the figures come from (0: none recorded yet)
+};
+
+// The latencies of a stage's last `capacity` items, for the p50/p99 of the health report.
+// A stage thread records, the health thread reads; a mutex is cheap at stage rates (<= kHz).
+class LatencyWindow {
+ public:
+  explicit LatencyWindow(std::size_t capacity = 1024);
+
+  void record(double seconds);
+  LatencyPercentiles percentiles() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<float> ms_;
+  std::size_t capacity_;
+  std::size_t next_ = 0;
+};
+
+}  // namespace semap::onboard
