@@ -42,13 +42,21 @@ class KernelTable {
 
   // Same value as operator(), without the clamp, for d2 known to be below ell^2 up to
   // rounding: there d2 / step stays below intervals + 1, whose entry (0, 0) gives exactly 0.
-  float inside(float d2) const {
-    const float s = d2 * inv_step_;
-    const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
-    return lines_[2 * i] + lines_[2 * i + 1] * s;
-  }
+  float inside(float d2) const { return view().inside(d2); }
 
   float ell_squared() const { return ell2_; }
+
+  // The table by value, for hot loops: inside() as above.
+  struct View {
+    const float* lines;
+    float inv_step;
+    float inside(float d2) const {
+      const float s = d2 * inv_step;
+      const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
+      return lines[2 * i] + lines[2 * i + 1] * s;
+    }
+  };
+  View view() const { return {lines_.data(), inv_step_}; }
 
  private:
   // Interleaved (offset, slope) per step; the entry at s = intervals is (0, 0).

@@ -19,6 +19,10 @@
 
 namespace semap::mapping {
 
+namespace detail {
+class TileInserter;
+}  // namespace detail
+
 struct MapStats {
   std::size_t blocks = 0;
   std::size_t cells = 0;           // allocated cells (blocks * cells per block)
@@ -48,6 +52,9 @@ struct InsertResult {
 class SemanticMap {
  public:
   explicit SemanticMap(const MapParams& params);
+  ~SemanticMap();
+  SemanticMap(SemanticMap&&) noexcept;
+  SemanticMap& operator=(SemanticMap&&) noexcept;
 
   const MapParams& params() const { return params_; }
 
@@ -100,6 +107,8 @@ class SemanticMap {
   std::deque<Block> blocks_;
   std::size_t scans_ = 0;
   std::size_t rejected_ = 0;
+  // Insertion engine with its per-scan buffers and per-thread scratch, reused across scans.
+  std::unique_ptr<detail::TileInserter> inserter_;
 };
 
 }  // namespace semap::mapping

@@ -1,0 +1,348 @@
+#include "tile_inserter.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+namespace semap::mapping::detail {
+
+namespace {
+
+// Cells a training point touches: for S-BKI all cells whose centre lies within ell per
+// axis (rows are trimmed to the sphere in the scatter loop), for S-CSM the cell containing
+// the point.
+CellBox support_of(const Eigen::Vector3f& p, const MapParams& params) {
+  const float inv_res = 1.0f / params.resolution;
+  CellBox box{};
+  for (int a = 0; a < 3; ++a) {
+    if (params.method == Method::kCsm) {
+      box.lo[a] = box.hi[a] = fast_floor(p[a] * inv_res);
+    } else {
+      box.lo[a] = fast_ceil((p[a] - params.ell) * inv_res - 0.5f);
+      box.hi[a] = fast_floor((p[a] + params.ell) * inv_res - 0.5f);
+    }
+  }
+  return box;
+}
+
+bool empty(const CellBox& box) {
+  return box.lo[0] > box.hi[0] || box.lo[1] > box.hi[1] || box.lo[2] > box.hi[2];
+}
+
+constexpr CellBox kEmptyBox{{0, 0, 0}, {-1, -1, -1}};
+
+// Tiles are 16 cells per side unless blocks are larger: big enough that most supports fit
+// in one, small enough that a K = 20 scratch tile (320 KiB) stays in L2.
+constexpr std::int32_t kMinTileShift = 4;
+
+// Points per parallel chunk of the per-point preparation.
+constexpr std::size_t kPointGrain = 1024;
+
+// Adds k(d) y_i to every cell of the tile-local `box` whose centre lies within ell of
+// point i and sets their bits in the row masks. `d2[a][c]` is the squared distance along
+// axis a to the centres of local cell box.lo[a] + c; the point lies at `centre_x` cells from
+// the centre of cell box.lo[0]. Hard labels touch one float per cell.
+template <bool kSoft>
+void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const CellBox& box,
+                  const std::array<const float*, 3>& d2, float centre_x, float inv_res,
+                  const TrainingSet& training, std::size_t i, const KernelTable& kernel) {
+  const auto k = static_cast<std::size_t>(training.num_classes);
+  const float ell2 = kernel.ell_squared();
+  const float* y = kSoft ? training.probabilities.data() + i * k : nullptr;
+  const std::int32_t width = box.hi[0] - box.lo[0] + 1;
+  const float* dx2 = d2[0];
+  // A copy in registers: the stores below would otherwise make the compiler reload the
+  // table's pointer for every cell.
+  const KernelTable::View lut = kernel.view();
+  for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
+    for (std::int32_t yy = box.lo[1]; yy <= box.hi[1]; ++yy) {
+      const float dyz2 = d2[2][z - box.lo[2]] + d2[1][yy - box.lo[1]];
+      if (dyz2 >= ell2) continue;
+      // x is inside when d2x < ell^2 - dyz2; its weight is the tabulated kernel of
+      // dyz2 + d2x.
+      const float rest = ell2 - dyz2;
+      const std::size_t row = static_cast<std::size_t>(z * side + yy) * side;
+      float* cells = evidence + (row + static_cast<std::size_t>(box.lo[0])) * k;
+      // Inside cells form one run around the point (d2x is convex in x). Estimate its ends
+      // from sqrt(rest), then settle them with the exact test, which moves them at most by
+      // one cell.
+      const float half = std::sqrt(rest) * inv_res;
+      std::int32_t x_lo = std::max(fast_ceil(centre_x - half), 0);
+      std::int32_t x_hi = std::min(fast_floor(centre_x + half), width - 1);
+      while (x_lo > 0 && dx2[x_lo - 1] < rest) --x_lo;
+      while (x_lo <= x_hi && !(dx2[x_lo] < rest)) ++x_lo;
+      while (x_hi < width - 1 && dx2[x_hi + 1] < rest) ++x_hi;
+      while (x_hi >= x_lo && !(dx2[x_hi] < rest)) --x_hi;
+      if (x_lo > x_hi) continue;
+      const std::uint32_t mask = ((std::uint32_t{2} << (x_hi - x_lo)) - 1) << x_lo;
+      if constexpr (kSoft) {
+        for (std::int32_t x = x_lo; x <= x_hi; ++x) {
+          const float w = lut.inside(dyz2 + dx2[x]);
+          float* alpha = cells + static_cast<std::size_t>(x) * k;
+          for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
+        }
+      } else {
+        float* column = cells + training.labels[i];
+        for (std::int32_t x = x_lo; x <= x_hi; ++x) {
+          column[static_cast<std::size_t>(x) * k] += lut.inside(dyz2 + dx2[x]);
+        }
+      }
+      rows[static_cast<std::size_t>(z * side + yy)] |= mask << box.lo[0];
+    }
+  }
+}
+
+}  // namespace
+
+TileInserter::TileInserter(const MapParams& params)
+    : params_(params),
+      block_shift_(params.block_depth - 1),
+      tile_shift_(std::max(params.block_depth - 1, kMinTileShift)),
+      blocks_per_tile_side_(1 << (tile_shift_ - block_shift_)),
+      mask_words_((static_cast<std::size_t>(blocks_per_tile_side_) * blocks_per_tile_side_ *
+                       blocks_per_tile_side_ +
+                   63) /
+                  64),
+      width_(params.method == Method::kCsm
+                 ? 0
+                 : static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 3) {}
+
+void TileInserter::prepare_points(const TrainingSet& training) {
+  const std::size_t count = training.size();
+  boxes_.resize(count);
+  bad_.resize(count);
+  distances_.resize(count * 3 * width_);
+  const float inv_res = 1.0f / params_.resolution;
+  const std::size_t soft_rows = training.probabilities.size() / params_.num_classes;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const std::int32_t label = training.labels[i];
+                        const bool label_ok =
+                            label >= 0 ? label < params_.num_classes : i < soft_rows;
+                        if (!label_ok || !mappable(training.points[i], inv_res)) {
+                          bad_[i] = 1;
+                          boxes_[i] = kEmptyBox;
+                          continue;
+                        }
+                        bad_[i] = 0;
+                        const CellBox box = support_of(training.points[i], params_);
+                        boxes_[i] = box;
+                        if (width_ == 0) continue;
+                        float* d2 = distances_.data() + i * 3 * width_;
+                        for (int a = 0; a < 3; ++a, d2 += width_) {
+                          // Widths never exceed width_ (2 ell / res + 1 at most).
+                          for (std::int32_t c = box.lo[a]; c <= box.hi[a]; ++c) {
+                            const float d = (static_cast<float>(c) + 0.5f) * params_.resolution -
+                                            training.points[i][a];
+                            d2[c - box.lo[a]] = d * d;
+                          }
+                        }
+                      }
+                    });
+}
+
+void TileInserter::group_by_tile(std::size_t count) {
+  const std::int32_t ts = tile_shift_;
+  const std::int32_t bs = block_shift_;
+  const std::int32_t t_side = blocks_per_tile_side_;
+  tile_ids_.reset(count / 16 + 16);
+  tiles_.clear();
+  block_masks_.clear();
+  pairs_.clear();
+  std::vector<std::uint32_t>& counts = fill_;
+  counts.clear();
+  // Direct-mapped cache of tile ids by the low bit of each tile coordinate: neighbouring
+  // points share tiles, so most lookups skip the hash table.
+  struct CacheEntry {
+    BlockIndex tile{0, 0, 0};
+    std::uint32_t id = VoxelHashMap::kNone;
+  };
+  std::array<CacheEntry, 8> cache{};
+  const auto tile_id = [&](const BlockIndex& t) {
+    CacheEntry& e =
+        cache[static_cast<std::size_t>((t.x & 1) | ((t.y & 1) << 1) | ((t.z & 1) << 2))];
+    if (e.id != VoxelHashMap::kNone && e.tile == t) return e.id;
+    e.tile = t;
+    e.id = tile_ids_.insert(t);
+    return e.id;
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    const CellBox& box = boxes_[i];
+    if (empty(box)) continue;
+    for (std::int32_t tz = box.lo[2] >> ts; tz <= box.hi[2] >> ts; ++tz) {
+      for (std::int32_t ty = box.lo[1] >> ts; ty <= box.hi[1] >> ts; ++ty) {
+        for (std::int32_t tx = box.lo[0] >> ts; tx <= box.hi[0] >> ts; ++tx) {
+          const std::array<std::int32_t, 3> t{tx, ty, tz};
+          const std::uint32_t id = tile_id(BlockIndex{tx, ty, tz});
+          if (id == tiles_.size()) {
+            tiles_.push_back(BlockIndex{tx, ty, tz});
+            counts.push_back(0);
+            block_masks_.resize(block_masks_.size() + mask_words_, 0);
+          }
+          ++counts[id];
+          pairs_.emplace_back(id, static_cast<std::uint32_t>(i));
+          // Blocks of this tile that the support overlaps, in tile-local block units.
+          std::array<std::int32_t, 3> blo{}, bhi{};
+          for (int a = 0; a < 3; ++a) {
+            const std::int32_t first = t[a] << ts;
+            const std::int32_t last = first + (1 << ts) - 1;
+            blo[a] = (std::max(box.lo[a], first) - first) >> bs;
+            bhi[a] = (std::min(box.hi[a], last) - first) >> bs;
+          }
+          const std::uint64_t xbits =
+              ((std::uint64_t{2} << bhi[0]) - 1) & ~((std::uint64_t{1} << blo[0]) - 1);
+          std::uint64_t* mask = block_masks_.data() + id * mask_words_;
+          for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) {
+            for (std::int32_t by = blo[1]; by <= bhi[1]; ++by) {
+              // A row of t_side <= 16 bits starts at a multiple of t_side: one word.
+              const auto bit = static_cast<std::size_t>((bz * t_side + by) * t_side);
+              mask[bit >> 6] |= xbits << (bit & 63);
+            }
+          }
+        }
+      }
+    }
+  }
+  // Counting sort: each tile's points in ascending order.
+  tile_offsets_.assign(tiles_.size() + 1, 0);
+  for (std::size_t t = 0; t < tiles_.size(); ++t)
+    tile_offsets_[t + 1] = tile_offsets_[t] + counts[t];
+  fill_.assign(tile_offsets_.begin(), tile_offsets_.end() - 1);
+  tile_points_.resize(pairs_.size());
+  for (const auto& [id, i] : pairs_) tile_points_[fill_[id]++] = i;
+}
+
+void TileInserter::create_blocks(const BlockAt& block_at, TileInsertResult& result) {
+  const std::int32_t t_side = blocks_per_tile_side_;
+  const std::int32_t per_tile = tile_shift_ - block_shift_;
+  block_offsets_.assign(tiles_.size() + 1, 0);
+  tile_blocks_.clear();
+  for (std::size_t t = 0; t < tiles_.size(); ++t) {
+    const std::uint64_t* mask = block_masks_.data() + t * mask_words_;
+    for (std::size_t w = 0; w < mask_words_; ++w) {
+      for (std::uint64_t bits = mask[w]; bits != 0; bits &= bits - 1) {
+        const auto local = static_cast<std::int32_t>(w * 64) + std::countr_zero(bits);
+        const BlockIndex index{(tiles_[t].x << per_tile) + local % t_side,
+                               (tiles_[t].y << per_tile) + (local / t_side) % t_side,
+                               (tiles_[t].z << per_tile) + local / (t_side * t_side)};
+        tile_blocks_.push_back({static_cast<std::uint32_t>(local), &block_at(index)});
+        result.updated_blocks.push_back(index);
+      }
+    }
+    block_offsets_[t + 1] = static_cast<std::uint32_t>(tile_blocks_.size());
+  }
+}
+
+void TileInserter::scatter_point(Scratch& scratch, const std::array<std::int32_t, 3>& base,
+                                 std::size_t i, const TrainingSet& training,
+                                 const KernelTable& kernel) const {
+  const std::int32_t side = 1 << tile_shift_;
+  const auto k = static_cast<std::size_t>(params_.num_classes);
+  const CellBox& support = boxes_[i];
+  CellBox box{};
+  for (int a = 0; a < 3; ++a) {
+    box.lo[a] = std::max(support.lo[a], base[a]) - base[a];
+    box.hi[a] = std::min(support.hi[a], base[a] + side - 1) - base[a];
+  }
+  if (params_.method == Method::kCsm) {
+    const std::size_t row = static_cast<std::size_t>(box.lo[2] * side + box.lo[1]);
+    float* alpha = scratch.evidence.data() + (row * side + box.lo[0]) * k;
+    if (training.labels[i] >= 0) {
+      alpha[training.labels[i]] += 1.0f;
+    } else {
+      const float* y = training.probabilities.data() + i * k;
+      for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
+    }
+    scratch.rows[row] |= std::uint32_t{1} << box.lo[0];
+    return;
+  }
+  const float* first = distances_.data() + i * 3 * width_;
+  std::array<const float*, 3> d2{};
+  for (int a = 0; a < 3; ++a) d2[a] = first + a * width_ + (base[a] + box.lo[a] - support.lo[a]);
+  const float inv_res = 1.0f / params_.resolution;
+  const float centre_x =
+      training.points[i].x() * inv_res - 0.5f - static_cast<float>(base[0] + box.lo[0]);
+  if (training.labels[i] >= 0) {
+    smooth_point<false>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, centre_x,
+                        inv_res, training, i, kernel);
+  } else {
+    smooth_point<true>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, centre_x,
+                       inv_res, training, i, kernel);
+  }
+}
+
+void TileInserter::write_back(Scratch& scratch, std::size_t tile) const {
+  const std::int32_t side = 1 << tile_shift_;
+  const std::int32_t n = 1 << block_shift_;
+  const std::int32_t t_side = blocks_per_tile_side_;
+  const auto k = static_cast<std::size_t>(params_.num_classes);
+  const std::size_t row_floats = static_cast<std::size_t>(n) * k;
+  const std::uint64_t low = (std::uint64_t{1} << n) - 1;
+  for (std::uint32_t j = block_offsets_[tile]; j < block_offsets_[tile + 1]; ++j) {
+    const auto local = static_cast<std::int32_t>(tile_blocks_[j].local);
+    Block& block = *tile_blocks_[j].block;
+    const std::int32_t x0 = (local % t_side) * n;
+    const std::int32_t y0 = ((local / t_side) % t_side) * n;
+    const std::int32_t z0 = (local / (t_side * t_side)) * n;
+    for (std::int32_t z = 0; z < n; ++z) {
+      for (std::int32_t y = 0; y < n; ++y) {
+        const auto row = static_cast<std::size_t>((z0 + z) * side + y0 + y);
+        const std::uint64_t bits = (std::uint64_t{scratch.rows[row]} >> x0) & low;
+        if (bits == 0) continue;
+        // Only cells with a bit are non-zero, so adding and clearing the whole block row
+        // is exact and leaves the scratch zeroed.
+        float* src = scratch.evidence.data() + (row * side + x0) * k;
+        const int cell = block.cell_of(0, y, z);
+        float* dst = block.cell_evidence_mutable(cell);
+        for (std::size_t f = 0; f < row_floats; ++f) dst[f] += src[f];
+        std::memset(src, 0, row_floats * sizeof(float));
+        block.mark_observed_word(cell >> 6, bits << (cell & 63));
+      }
+    }
+  }
+  std::fill(scratch.rows.begin(), scratch.rows.end(), 0u);
+}
+
+void TileInserter::process_tile(std::size_t tile, const TrainingSet& training,
+                                const KernelTable& kernel) {
+  const std::int32_t side = 1 << tile_shift_;
+  Scratch& scratch = scratch_.local();
+  if (scratch.rows.empty()) {
+    const auto cells = static_cast<std::size_t>(side) * side * side;
+    scratch.evidence.assign(cells * static_cast<std::size_t>(params_.num_classes), 0.0f);
+    scratch.rows.assign(static_cast<std::size_t>(side) * side, 0u);
+  }
+  const std::array<std::int32_t, 3> base{
+      tiles_[tile].x << tile_shift_, tiles_[tile].y << tile_shift_, tiles_[tile].z << tile_shift_};
+  for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
+    scatter_point(scratch, base, tile_points_[p], training, kernel);
+  }
+  write_back(scratch, tile);
+}
+
+TileInsertResult TileInserter::insert(const TrainingSet& training, const KernelTable& kernel,
+                                      const BlockAt& block_at) {
+  TileInsertResult result;
+  prepare_points(training);
+  result.rejected_points = static_cast<std::size_t>(std::count(bad_.begin(), bad_.end(), 1));
+  group_by_tile(training.size());
+  // Creating blocks mutates the map's table, so it happens before the parallel part.
+  create_blocks(block_at, result);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, tiles_.size(), 1),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+          process_tile(t, training, kernel);
+        }
+      },
+      tbb::simple_partitioner());
+  return result;
+}
+
+}  // namespace semap::mapping::detail

@@ -1,0 +1,119 @@
+#pragma once
+
+// Internal to semap_mapping: the insertion engine behind SemanticMap::insert.
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "semap/mapping/block.hpp"
+#include "semap/mapping/block_index.hpp"
+#include "semap/mapping/kernel.hpp"
+#include "semap/mapping/map_params.hpp"
+#include "semap/mapping/training_data.hpp"
+#include "semap/mapping/voxel_hash_map.hpp"
+
+namespace semap::mapping::detail {
+
+// std::floor/ceil are library calls without SSE4.1; these are exact for |x| < 2^31.
+inline std::int32_t fast_floor(float x) {
+  const auto i = static_cast<std::int32_t>(x);
+  return i - static_cast<std::int32_t>(x < static_cast<float>(i));
+}
+inline std::int32_t fast_ceil(float x) {
+  const auto i = static_cast<std::int32_t>(x);
+  return i + static_cast<std::int32_t>(x > static_cast<float>(i));
+}
+
+// Training points and queries are dropped when their cell coordinates could overflow the
+// block keys.
+inline bool mappable(const Eigen::Vector3f& p, float inv_res) {
+  constexpr float kLimit = static_cast<float>(1 << 20) - 64.0f;
+  return p.allFinite() && (p.cwiseAbs() * inv_res).maxCoeff() < kLimit;
+}
+
+// Inclusive range of cell coordinates per axis; empty when lo > hi.
+struct CellBox {
+  std::array<std::int32_t, 3> lo;
+  std::array<std::int32_t, 3> hi;
+};
+
+// What one insert touched, filled by TileInserter::insert.
+struct TileInsertResult {
+  std::size_t rejected_points = 0;
+  std::vector<BlockIndex> updated_blocks;
+};
+
+// A tile is a cube of tile_side cells (16, or one block when blocks are larger): the unit of
+// parallel work. A training point's support (6 cells wide for the toy run) overlaps about
+// 2.3 tiles instead of about 11 blocks of 4 cells, so the per-(point, piece) clipping runs
+// a fifth as often, and the scatter loop writes into a dense per-thread scratch tile (same
+// cell-major layout as a block) instead of finding the block of every row.
+//
+// Every tile is processed by one task that visits its points in input order, adds their
+// weights into the zeroed scratch, then adds the scratch to the tile's blocks and zeroes it
+// again. Per cell this is evidence + (sum of this scan's weights in input order), whatever
+// the thread count.
+class TileInserter {
+ public:
+  using BlockAt = std::function<Block&(const BlockIndex&)>;
+
+  explicit TileInserter(const MapParams& params);
+
+  // Fuses `training`; points with a bad label or unmappable coordinates are rejected and
+  // counted. `block_at` returns the block at an index, creating it; it is called serially
+  // before the parallel part.
+  TileInsertResult insert(const TrainingSet& training, const KernelTable& kernel,
+                          const BlockAt& block_at);
+
+ private:
+  // Per-thread scratch of one tile: tile_side^3 cells of K floats, and one bit mask per
+  // row of tile_side cells saying which cells got a weight (they are the observed ones and
+  // the only non-zero scratch cells).
+  struct Scratch {
+    std::vector<float> evidence;
+    std::vector<std::uint32_t> rows;
+  };
+  // A block of a tile: its position inside the tile (x fastest) and the block itself.
+  struct TileBlock {
+    std::uint32_t local;
+    Block* block;
+  };
+
+  void prepare_points(const TrainingSet& training);
+  void group_by_tile(std::size_t count);
+  void create_blocks(const BlockAt& block_at, TileInsertResult& result);
+  void process_tile(std::size_t tile, const TrainingSet& training, const KernelTable& kernel);
+  void scatter_point(Scratch& scratch, const std::array<std::int32_t, 3>& base, std::size_t i,
+                     const TrainingSet& training, const KernelTable& kernel) const;
+  void write_back(Scratch& scratch, std::size_t tile) const;
+
+  MapParams params_;
+  std::int32_t block_shift_;  // log2(cells per block side)
+  std::int32_t tile_shift_;   // log2(cells per tile side)
+  std::int32_t blocks_per_tile_side_;
+  std::size_t mask_words_;  // 64-bit words of a tile's block mask
+  std::size_t width_;       // distances stored per point and axis
+
+  // Per-scan buffers, kept across scans to avoid reallocating them.
+  std::vector<CellBox> boxes_;     // support of each training point (empty if unusable)
+  std::vector<float> distances_;   // S-BKI: squared axis distances, 3 * width_ per point
+  std::vector<std::uint8_t> bad_;  // 1 for rejected points
+  VoxelHashMap tile_ids_;
+  std::vector<BlockIndex> tiles_;
+  std::vector<std::uint32_t> tile_offsets_;  // tiles_.size() + 1, into tile_points_
+  std::vector<std::uint32_t> tile_points_;
+  std::vector<std::uint64_t> block_masks_;                      // mask_words_ per tile
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  // (tile, point)
+  std::vector<std::uint32_t> fill_;
+  std::vector<std::uint32_t> block_offsets_;  // tiles_.size() + 1, into tile_blocks_
+  std::vector<TileBlock> tile_blocks_;
+  tbb::enumerable_thread_specific<Scratch> scratch_;
+};
+
+}  // namespace semap::mapping::detail
