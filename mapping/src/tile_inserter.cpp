@@ -45,11 +45,11 @@ constexpr std::size_t kPointGrain = 1024;
 
 // Adds k(d) y_i to every cell of the tile-local `box` whose centre lies within ell of
 // point i and sets their bits in the row masks. `d2[a][c]` is the squared distance along
-// axis a to the centres of local cell box.lo[a] + c; the point lies at `centre_x` cells from
-// the centre of cell box.lo[0]. Hard labels touch one float per cell.
+// axis a to the centres of local cell box.lo[a] + c; the first `left` cells along x have
+// their centres before the point. Hard labels touch one float per cell.
 template <bool kSoft>
 void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const CellBox& box,
-                  const std::array<const float*, 3>& d2, float centre_x, float inv_res,
+                  const std::array<const float*, 3>& d2, std::int32_t left,
                   const TrainingSet& training, std::size_t i, const KernelTable& kernel) {
   const auto k = static_cast<std::size_t>(training.num_classes);
   const float ell2 = kernel.ell_squared();
@@ -59,27 +59,27 @@ void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const
   // A copy in registers: the stores below would otherwise make the compiler reload the
   // table's pointer for every cell.
   const KernelTable::View lut = kernel.view();
+  const std::size_t row_stride = static_cast<std::size_t>(side) * k;
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
-    for (std::int32_t yy = box.lo[1]; yy <= box.hi[1]; ++yy) {
-      const float dyz2 = d2[2][z - box.lo[2]] + d2[1][yy - box.lo[1]];
+    const float dz2 = d2[2][z - box.lo[2]];
+    const std::size_t first_row = static_cast<std::size_t>(z * side + box.lo[1]);
+    float* cells = evidence + (first_row * side + static_cast<std::size_t>(box.lo[0])) * k;
+    std::uint32_t* mask_of_row = rows + first_row;
+    for (std::int32_t yy = 0; yy <= box.hi[1] - box.lo[1];
+         ++yy, cells += row_stride, ++mask_of_row) {
+      const float dyz2 = dz2 + d2[1][yy];
       if (dyz2 >= ell2) continue;
       // x is inside when d2x < ell^2 - dyz2; its weight is the tabulated kernel of
-      // dyz2 + d2x.
+      // dyz2 + d2x. d2x falls towards the point and rises after it, so the inside cells are
+      // the last ones of the first `left` and the first ones of the rest: count them
+      // without branches.
       const float rest = ell2 - dyz2;
-      const std::size_t row = static_cast<std::size_t>(z * side + yy) * side;
-      float* cells = evidence + (row + static_cast<std::size_t>(box.lo[0])) * k;
-      // Inside cells form one run around the point (d2x is convex in x). Estimate its ends
-      // from sqrt(rest), then settle them with the exact test, which moves them at most by
-      // one cell.
-      const float half = std::sqrt(rest) * inv_res;
-      std::int32_t x_lo = std::max(fast_ceil(centre_x - half), 0);
-      std::int32_t x_hi = std::min(fast_floor(centre_x + half), width - 1);
-      while (x_lo > 0 && dx2[x_lo - 1] < rest) --x_lo;
-      while (x_lo <= x_hi && !(dx2[x_lo] < rest)) ++x_lo;
-      while (x_hi < width - 1 && dx2[x_hi + 1] < rest) ++x_hi;
-      while (x_hi >= x_lo && !(dx2[x_hi] < rest)) --x_hi;
-      if (x_lo > x_hi) continue;
-      const std::uint32_t mask = ((std::uint32_t{2} << (x_hi - x_lo)) - 1) << x_lo;
+      std::int32_t before = 0, after = 0;
+      for (std::int32_t x = 0; x < left; ++x) before += dx2[x] < rest ? 1 : 0;
+      for (std::int32_t x = left; x < width; ++x) after += dx2[x] < rest ? 1 : 0;
+      if (before + after == 0) continue;
+      const std::int32_t x_lo = left - before;
+      const std::int32_t x_hi = left + after - 1;
       if constexpr (kSoft) {
         for (std::int32_t x = x_lo; x <= x_hi; ++x) {
           const float w = lut.inside(dyz2 + dx2[x]);
@@ -92,7 +92,7 @@ void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const
           column[static_cast<std::size_t>(x) * k] += lut.inside(dyz2 + dx2[x]);
         }
       }
-      rows[static_cast<std::size_t>(z * side + yy)] |= mask << box.lo[0];
+      *mask_of_row |= ((std::uint32_t{2} << (x_hi - x_lo)) - 1) << (x_lo + box.lo[0]);
     }
   }
 }
@@ -117,6 +117,7 @@ void TileInserter::prepare_points(const TrainingSet& training) {
   boxes_.resize(count);
   bad_.resize(count);
   distances_.resize(count * 3 * width_);
+  lefts_.resize(count);
   const float inv_res = 1.0f / params_.resolution;
   const std::size_t soft_rows = training.probabilities.size() / params_.num_classes;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
@@ -135,14 +136,17 @@ void TileInserter::prepare_points(const TrainingSet& training) {
                         boxes_[i] = box;
                         if (width_ == 0) continue;
                         float* d2 = distances_.data() + i * 3 * width_;
+                        std::int32_t left = 0;
                         for (int a = 0; a < 3; ++a, d2 += width_) {
                           // Widths never exceed width_ (2 ell / res + 1 at most).
                           for (std::int32_t c = box.lo[a]; c <= box.hi[a]; ++c) {
                             const float d = (static_cast<float>(c) + 0.5f) * params_.resolution -
                                             training.points[i][a];
                             d2[c - box.lo[a]] = d * d;
+                            if (a == 0) left += d < 0.0f ? 1 : 0;
                           }
                         }
+                        lefts_[i] = left;
                       }
                     });
 }
@@ -265,15 +269,14 @@ void TileInserter::scatter_point(Scratch& scratch, const std::array<std::int32_t
   const float* first = distances_.data() + i * 3 * width_;
   std::array<const float*, 3> d2{};
   for (int a = 0; a < 3; ++a) d2[a] = first + a * width_ + (base[a] + box.lo[a] - support.lo[a]);
-  const float inv_res = 1.0f / params_.resolution;
-  const float centre_x =
-      training.points[i].x() * inv_res - 0.5f - static_cast<float>(base[0] + box.lo[0]);
+  const std::int32_t left =
+      std::clamp(lefts_[i] - (base[0] + box.lo[0] - support.lo[0]), 0, box.hi[0] - box.lo[0] + 1);
   if (training.labels[i] >= 0) {
-    smooth_point<false>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, centre_x,
-                        inv_res, training, i, kernel);
+    smooth_point<false>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, left, training,
+                        i, kernel);
   } else {
-    smooth_point<true>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, centre_x,
-                       inv_res, training, i, kernel);
+    smooth_point<true>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, left, training,
+                       i, kernel);
   }
 }
 

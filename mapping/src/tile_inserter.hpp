@@ -101,9 +101,10 @@ class TileInserter {
   std::size_t width_;       // distances stored per point and axis
 
   // Per-scan buffers, kept across scans to avoid reallocating them.
-  std::vector<CellBox> boxes_;     // support of each training point (empty if unusable)
-  std::vector<float> distances_;   // S-BKI: squared axis distances, 3 * width_ per point
-  std::vector<std::uint8_t> bad_;  // 1 for rejected points
+  std::vector<CellBox> boxes_;       // support of each training point (empty if unusable)
+  std::vector<float> distances_;     // S-BKI: squared axis distances, 3 * width_ per point
+  std::vector<std::int32_t> lefts_;  // S-BKI: support cells along x with centres before the point
+  std::vector<std::uint8_t> bad_;    // 1 for rejected points
   VoxelHashMap tile_ids_;
   std::vector<BlockIndex> tiles_;
   std::vector<std::uint32_t> tile_offsets_;  // tiles_.size() + 1, into tile_points_
