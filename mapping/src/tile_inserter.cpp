@@ -36,9 +36,21 @@ bool empty(const CellBox& box) {
 
 constexpr CellBox kEmptyBox{{0, 0, 0}, {-1, -1, -1}};
 
-// Tiles are 16 cells per side unless blocks are larger: big enough that most supports fit
-// in one, small enough that a K = 20 scratch tile (320 KiB) stays in L2.
-constexpr std::int32_t kMinTileShift = 4;
+// Tiles are 32 cells per side when the scratch tile fits in kScratchBytes, else 16, unless
+// blocks are larger: big enough that most supports fit in one (fewer pieces and split rows),
+// small enough that the scratch stays in L2 (K = 4: 512 KiB; K = 20: 16^3 cells, 320 KiB).
+constexpr std::size_t kScratchBytes = 512 * 1024;
+constexpr std::int32_t kDirectBlockShift = 3;
+
+std::int32_t tile_shift_for(const MapParams& params) {
+  const std::int32_t block_shift = params.block_depth - 1;
+  // Blocks of 8+ cells per side are tiles themselves: a support rarely spans many of them,
+  // and the scratch's write-back (n K floats per touched block row) would cost more than
+  // it saves at large K.
+  if (block_shift >= kDirectBlockShift) return block_shift;
+  const std::size_t big = std::size_t{32 * 32 * 32} * sizeof(float) * params.num_classes;
+  return big <= kScratchBytes ? 5 : 4;
+}
 
 // Points per parallel chunk of the per-point preparation.
 constexpr std::size_t kPointGrain = 1024;
@@ -48,7 +60,7 @@ constexpr std::size_t kPointGrain = 1024;
 // axis a to the centres of local cell box.lo[a] + c; the first `left` cells along x have
 // their centres before the point. Hard labels touch one float per cell.
 template <bool kSoft>
-void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const CellBox& box,
+void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& box,
                   const std::array<const float*, 3>& d2, std::int32_t left,
                   const TrainingSet& training, std::size_t i, const KernelTable& kernel) {
   const auto k = static_cast<std::size_t>(training.num_classes);
@@ -63,10 +75,8 @@ void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
     const float dz2 = d2[2][z - box.lo[2]];
     const std::size_t first_row = static_cast<std::size_t>(z * side + box.lo[1]);
-    float* cells = evidence + (first_row * side + static_cast<std::size_t>(box.lo[0])) * k;
-    std::uint32_t* mask_of_row = rows + first_row;
-    for (std::int32_t yy = 0; yy <= box.hi[1] - box.lo[1];
-         ++yy, cells += row_stride, ++mask_of_row) {
+    float* cells = target.evidence + (first_row * side + static_cast<std::size_t>(box.lo[0])) * k;
+    for (std::int32_t yy = 0; yy <= box.hi[1] - box.lo[1]; ++yy, cells += row_stride) {
       const float dyz2 = dz2 + d2[1][yy];
       if (dyz2 >= ell2) continue;
       // x is inside when d2x < ell^2 - dyz2; its weight is the tabulated kernel of
@@ -92,7 +102,8 @@ void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const
           column[static_cast<std::size_t>(x) * k] += lut.inside(dyz2 + dx2[x]);
         }
       }
-      *mask_of_row |= ((std::uint32_t{2} << (x_hi - x_lo)) - 1) << (x_lo + box.lo[0]);
+      target.mark(first_row + static_cast<std::size_t>(yy),
+                  ((std::uint32_t{2} << (x_hi - x_lo)) - 1) << (x_lo + box.lo[0]), side);
     }
   }
 }
@@ -102,7 +113,7 @@ void smooth_point(float* evidence, std::uint32_t* rows, std::int32_t side, const
 TileInserter::TileInserter(const MapParams& params)
     : params_(params),
       block_shift_(params.block_depth - 1),
-      tile_shift_(std::max(params.block_depth - 1, kMinTileShift)),
+      tile_shift_(tile_shift_for(params)),
       blocks_per_tile_side_(1 << (tile_shift_ - block_shift_)),
       mask_words_((static_cast<std::size_t>(blocks_per_tile_side_) * blocks_per_tile_side_ *
                        blocks_per_tile_side_ +
@@ -243,7 +254,7 @@ void TileInserter::create_blocks(const BlockAt& block_at, TileInsertResult& resu
   }
 }
 
-void TileInserter::scatter_point(Scratch& scratch, const std::array<std::int32_t, 3>& base,
+void TileInserter::scatter_point(const TileTarget& target, const std::array<std::int32_t, 3>& base,
                                  std::size_t i, const TrainingSet& training,
                                  const KernelTable& kernel) const {
   const std::int32_t side = 1 << tile_shift_;
@@ -256,14 +267,14 @@ void TileInserter::scatter_point(Scratch& scratch, const std::array<std::int32_t
   }
   if (params_.method == Method::kCsm) {
     const std::size_t row = static_cast<std::size_t>(box.lo[2] * side + box.lo[1]);
-    float* alpha = scratch.evidence.data() + (row * side + box.lo[0]) * k;
+    float* alpha = target.evidence + (row * side + box.lo[0]) * k;
     if (training.labels[i] >= 0) {
       alpha[training.labels[i]] += 1.0f;
     } else {
       const float* y = training.probabilities.data() + i * k;
       for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
     }
-    scratch.rows[row] |= std::uint32_t{1} << box.lo[0];
+    target.mark(row, std::uint32_t{1} << box.lo[0], side);
     return;
   }
   const float* first = distances_.data() + i * 3 * width_;
@@ -272,11 +283,9 @@ void TileInserter::scatter_point(Scratch& scratch, const std::array<std::int32_t
   const std::int32_t left =
       std::clamp(lefts_[i] - (base[0] + box.lo[0] - support.lo[0]), 0, box.hi[0] - box.lo[0] + 1);
   if (training.labels[i] >= 0) {
-    smooth_point<false>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, left, training,
-                        i, kernel);
+    smooth_point<false>(target, side, box, d2, left, training, i, kernel);
   } else {
-    smooth_point<true>(scratch.evidence.data(), scratch.rows.data(), side, box, d2, left, training,
-                       i, kernel);
+    smooth_point<true>(target, side, box, d2, left, training, i, kernel);
   }
 }
 
@@ -315,16 +324,26 @@ void TileInserter::write_back(Scratch& scratch, std::size_t tile) const {
 void TileInserter::process_tile(std::size_t tile, const TrainingSet& training,
                                 const KernelTable& kernel) {
   const std::int32_t side = 1 << tile_shift_;
+  const std::array<std::int32_t, 3> base{
+      tiles_[tile].x << tile_shift_, tiles_[tile].y << tile_shift_, tiles_[tile].z << tile_shift_};
+  if (tile_shift_ == block_shift_) {
+    // The tile is one block: write into it directly, in the same order as the scratch would.
+    Block* block = tile_blocks_[block_offsets_[tile]].block;
+    const TileTarget target{block->cell_evidence_mutable(0), nullptr, block};
+    for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
+      scatter_point(target, base, tile_points_[p], training, kernel);
+    }
+    return;
+  }
   Scratch& scratch = scratch_.local();
   if (scratch.rows.empty()) {
     const auto cells = static_cast<std::size_t>(side) * side * side;
     scratch.evidence.assign(cells * static_cast<std::size_t>(params_.num_classes), 0.0f);
     scratch.rows.assign(static_cast<std::size_t>(side) * side, 0u);
   }
-  const std::array<std::int32_t, 3> base{
-      tiles_[tile].x << tile_shift_, tiles_[tile].y << tile_shift_, tiles_[tile].z << tile_shift_};
+  const TileTarget target{scratch.evidence.data(), scratch.rows.data(), nullptr};
   for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
-    scatter_point(scratch, base, tile_points_[p], training, kernel);
+    scatter_point(target, base, tile_points_[p], training, kernel);
   }
   write_back(scratch, tile);
 }

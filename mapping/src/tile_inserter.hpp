@@ -43,6 +43,25 @@ struct CellBox {
   std::array<std::int32_t, 3> hi;
 };
 
+// Where a tile's weights go: cell-major evidence of side^3 cells (cell (z side + y) side + x)
+// and the observed bits of each row of side cells, either as row masks of the scratch tile or,
+// when the tile is one block, as the block's own bits.
+struct TileTarget {
+  float* evidence;
+  std::uint32_t* rows;  // scratch row masks, or nullptr to mark `block`
+  Block* block;
+
+  void mark(std::size_t row, std::uint32_t bits, std::int32_t side) const {
+    if (rows != nullptr) {
+      rows[row] |= bits;
+    } else {
+      // A row of n <= 32 cells starts at a multiple of n, so it lies in one 64-bit word.
+      const std::size_t cell = row * static_cast<std::size_t>(side);
+      block->mark_observed_word(static_cast<int>(cell >> 6), std::uint64_t{bits} << (cell & 63));
+    }
+  }
+};
+
 // What one insert touched, filled by TileInserter::insert.
 struct TileInsertResult {
   std::size_t rejected_points = 0;
@@ -89,8 +108,8 @@ class TileInserter {
   void group_by_tile(std::size_t count);
   void create_blocks(const BlockAt& block_at, TileInsertResult& result);
   void process_tile(std::size_t tile, const TrainingSet& training, const KernelTable& kernel);
-  void scatter_point(Scratch& scratch, const std::array<std::int32_t, 3>& base, std::size_t i,
-                     const TrainingSet& training, const KernelTable& kernel) const;
+  void scatter_point(const TileTarget& target, const std::array<std::int32_t, 3>& base,
+                     std::size_t i, const TrainingSet& training, const KernelTable& kernel) const;
   void write_back(Scratch& scratch, std::size_t tile) const;
 
   MapParams params_;
