@@ -164,73 +164,92 @@ void TileInserter::prepare_points(const TrainingSet& training) {
 
 void TileInserter::group_by_tile(std::size_t count) {
   const std::int32_t ts = tile_shift_;
+  // 1. Tiles per point (parallel), then where each point's (point, tile) pairs start.
+  pair_first_.assign(count + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const CellBox& box = boxes_[i];
+                        std::uint32_t tiles = empty(box) ? 0 : 1;
+                        for (int a = 0; a < 3 && tiles; ++a) {
+                          tiles *=
+                              static_cast<std::uint32_t>((box.hi[a] >> ts) - (box.lo[a] >> ts) + 1);
+                        }
+                        pair_first_[i + 1] = tiles;
+                      }
+                    });
+  for (std::size_t i = 0; i < count; ++i) pair_first_[i + 1] += pair_first_[i];
+  const std::size_t pairs = pair_first_[count];
+  // 2. The tile of every pair, in point order (parallel).
+  pair_tiles_.resize(pairs);
+  pair_points_.resize(pairs);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const CellBox& box = boxes_[i];
+                        std::size_t j = pair_first_[i];
+                        if (j == pair_first_[i + 1]) continue;
+                        for (std::int32_t tz = box.lo[2] >> ts; tz <= box.hi[2] >> ts; ++tz) {
+                          for (std::int32_t ty = box.lo[1] >> ts; ty <= box.hi[1] >> ts; ++ty) {
+                            for (std::int32_t tx = box.lo[0] >> ts; tx <= box.hi[0] >> ts;
+                                 ++tx, ++j) {
+                              pair_tiles_[j] = BlockIndex{tx, ty, tz};
+                              pair_points_[j] = static_cast<std::uint32_t>(i);
+                            }
+                          }
+                        }
+                      }
+                    });
+  // 3. Tiles numbered by first occurrence (parallel shards for large scans).
+  tile_grouping_.group(pair_tiles_, {});
+  const auto tile_of_pair = tile_grouping_.voxel_of();
+  tiles_.clear();
+  std::vector<std::uint32_t>& counts = fill_;
+  counts.assign(tile_grouping_.voxels(), 0);
+  for (std::size_t j = 0; j < pairs; ++j) {
+    const std::uint32_t id = tile_of_pair[j];
+    if (id == tiles_.size()) tiles_.push_back(pair_tiles_[j]);
+    ++counts[id];
+  }
+  // 4. Counting sort: each tile's points in ascending order.
+  tile_offsets_.assign(tiles_.size() + 1, 0);
+  for (std::size_t t = 0; t < tiles_.size(); ++t) {
+    tile_offsets_[t + 1] = tile_offsets_[t] + counts[t];
+  }
+  fill_.assign(tile_offsets_.begin(), tile_offsets_.end() - 1);
+  tile_points_.resize(pairs);
+  for (std::size_t j = 0; j < pairs; ++j) tile_points_[fill_[tile_of_pair[j]]++] = pair_points_[j];
+  // 5. Blocks of each tile that its points' supports overlap (parallel over tiles).
+  block_masks_.assign(tiles_.size() * mask_words_, 0);
+  tbb::parallel_for(std::size_t{0}, tiles_.size(), [&](std::size_t t) { mark_blocks(t); });
+}
+
+void TileInserter::mark_blocks(std::size_t tile) {
+  const std::int32_t ts = tile_shift_;
   const std::int32_t bs = block_shift_;
   const std::int32_t t_side = blocks_per_tile_side_;
-  tile_ids_.reset(count / 16 + 16);
-  tiles_.clear();
-  block_masks_.clear();
-  pairs_.clear();
-  std::vector<std::uint32_t>& counts = fill_;
-  counts.clear();
-  // Direct-mapped cache of tile ids by the low bit of each tile coordinate: neighbouring
-  // points share tiles, so most lookups skip the hash table.
-  struct CacheEntry {
-    BlockIndex tile{0, 0, 0};
-    std::uint32_t id = VoxelHashMap::kNone;
-  };
-  std::array<CacheEntry, 8> cache{};
-  const auto tile_id = [&](const BlockIndex& t) {
-    CacheEntry& e =
-        cache[static_cast<std::size_t>((t.x & 1) | ((t.y & 1) << 1) | ((t.z & 1) << 2))];
-    if (e.id != VoxelHashMap::kNone && e.tile == t) return e.id;
-    e.tile = t;
-    e.id = tile_ids_.insert(t);
-    return e.id;
-  };
-  for (std::size_t i = 0; i < count; ++i) {
-    const CellBox& box = boxes_[i];
-    if (empty(box)) continue;
-    for (std::int32_t tz = box.lo[2] >> ts; tz <= box.hi[2] >> ts; ++tz) {
-      for (std::int32_t ty = box.lo[1] >> ts; ty <= box.hi[1] >> ts; ++ty) {
-        for (std::int32_t tx = box.lo[0] >> ts; tx <= box.hi[0] >> ts; ++tx) {
-          const std::array<std::int32_t, 3> t{tx, ty, tz};
-          const std::uint32_t id = tile_id(BlockIndex{tx, ty, tz});
-          if (id == tiles_.size()) {
-            tiles_.push_back(BlockIndex{tx, ty, tz});
-            counts.push_back(0);
-            block_masks_.resize(block_masks_.size() + mask_words_, 0);
-          }
-          ++counts[id];
-          pairs_.emplace_back(id, static_cast<std::uint32_t>(i));
-          // Blocks of this tile that the support overlaps, in tile-local block units.
-          std::array<std::int32_t, 3> blo{}, bhi{};
-          for (int a = 0; a < 3; ++a) {
-            const std::int32_t first = t[a] << ts;
-            const std::int32_t last = first + (1 << ts) - 1;
-            blo[a] = (std::max(box.lo[a], first) - first) >> bs;
-            bhi[a] = (std::min(box.hi[a], last) - first) >> bs;
-          }
-          const std::uint64_t xbits =
-              ((std::uint64_t{2} << bhi[0]) - 1) & ~((std::uint64_t{1} << blo[0]) - 1);
-          std::uint64_t* mask = block_masks_.data() + id * mask_words_;
-          for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) {
-            for (std::int32_t by = blo[1]; by <= bhi[1]; ++by) {
-              // A row of t_side <= 16 bits starts at a multiple of t_side: one word.
-              const auto bit = static_cast<std::size_t>((bz * t_side + by) * t_side);
-              mask[bit >> 6] |= xbits << (bit & 63);
-            }
-          }
-        }
+  const std::array<std::int32_t, 3> t{tiles_[tile].x, tiles_[tile].y, tiles_[tile].z};
+  std::uint64_t* mask = block_masks_.data() + tile * mask_words_;
+  for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
+    const CellBox& box = boxes_[tile_points_[p]];
+    // Blocks of this tile that the support overlaps, in tile-local block units.
+    std::array<std::int32_t, 3> blo{}, bhi{};
+    for (int a = 0; a < 3; ++a) {
+      const std::int32_t first = t[a] << ts;
+      const std::int32_t last = first + (1 << ts) - 1;
+      blo[a] = (std::max(box.lo[a], first) - first) >> bs;
+      bhi[a] = (std::min(box.hi[a], last) - first) >> bs;
+    }
+    const std::uint64_t xbits =
+        ((std::uint64_t{2} << bhi[0]) - 1) & ~((std::uint64_t{1} << blo[0]) - 1);
+    for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) {
+      for (std::int32_t by = blo[1]; by <= bhi[1]; ++by) {
+        // A row of t_side <= 16 bits starts at a multiple of t_side: one word.
+        const auto bit = static_cast<std::size_t>((bz * t_side + by) * t_side);
+        mask[bit >> 6] |= xbits << (bit & 63);
       }
     }
   }
-  // Counting sort: each tile's points in ascending order.
-  tile_offsets_.assign(tiles_.size() + 1, 0);
-  for (std::size_t t = 0; t < tiles_.size(); ++t)
-    tile_offsets_[t + 1] = tile_offsets_[t] + counts[t];
-  fill_.assign(tile_offsets_.begin(), tile_offsets_.end() - 1);
-  tile_points_.resize(pairs_.size());
-  for (const auto& [id, i] : pairs_) tile_points_[fill_[id]++] = i;
 }
 
 void TileInserter::create_blocks(const BlockAt& block_at, TileInsertResult& result) {

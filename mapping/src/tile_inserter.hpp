@@ -17,6 +17,7 @@
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/training_data.hpp"
 #include "semap/mapping/voxel_hash_map.hpp"
+#include "voxel_grouping.hpp"
 
 namespace semap::mapping::detail {
 
@@ -106,6 +107,7 @@ class TileInserter {
 
   void prepare_points(const TrainingSet& training);
   void group_by_tile(std::size_t count);
+  void mark_blocks(std::size_t tile);
   void create_blocks(const BlockAt& block_at, TileInsertResult& result);
   void process_tile(std::size_t tile, const TrainingSet& training, const KernelTable& kernel);
   void scatter_point(const TileTarget& target, const std::array<std::int32_t, 3>& base,
@@ -124,12 +126,14 @@ class TileInserter {
   std::vector<float> distances_;     // S-BKI: squared axis distances, 3 * width_ per point
   std::vector<std::int32_t> lefts_;  // S-BKI: support cells along x with centres before the point
   std::vector<std::uint8_t> bad_;    // 1 for rejected points
-  VoxelHashMap tile_ids_;
+  std::vector<std::uint32_t> pair_first_;  // count + 1: first (point, tile) pair of each point
+  std::vector<BlockIndex> pair_tiles_;
+  std::vector<std::uint32_t> pair_points_;
+  VoxelGrouping tile_grouping_;
   std::vector<BlockIndex> tiles_;
   std::vector<std::uint32_t> tile_offsets_;  // tiles_.size() + 1, into tile_points_
   std::vector<std::uint32_t> tile_points_;
-  std::vector<std::uint64_t> block_masks_;                      // mask_words_ per tile
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;  // (tile, point)
+  std::vector<std::uint64_t> block_masks_;  // mask_words_ per tile
   std::vector<std::uint32_t> fill_;
   std::vector<std::uint32_t> block_offsets_;  // tiles_.size() + 1, into tile_blocks_
   std::vector<TileBlock> tile_blocks_;
