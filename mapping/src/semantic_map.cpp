@@ -101,7 +101,8 @@ Block& SemanticMap::block_at(const BlockIndex& index) {
   const std::uint32_t id = table_.insert(index);
   if (id == blocks_.size()) {
     indices_.push_back(index);
-    blocks_.emplace_back(params_.cells_per_side(), params_.num_classes);
+    const auto floats = static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
+    blocks_.emplace_back(params_.cells_per_side(), params_.num_classes, arena_.allocate(floats));
   }
   return blocks_[id];
 }
@@ -127,11 +128,16 @@ MapStats SemanticMap::stats() const {
   // Table, index list and the deque's slots, then every block with its two heap arrays.
   s.bytes =
       table_.bytes() + indices_.capacity() * sizeof(BlockIndex) + blocks_.size() * sizeof(Block);
+  std::size_t evidence_bytes = 0;
   for (const Block& block : blocks_) {
     s.cells += static_cast<std::size_t>(block.num_cells());
     s.observed_cells += static_cast<std::size_t>(block.num_observed());
-    s.bytes += block.bytes() - sizeof(Block) + 2 * kAllocOverhead;
+    // The observed bits are one heap allocation; the evidence lives in the arena.
+    s.bytes += block.bytes() - sizeof(Block) + kAllocOverhead;
+    evidence_bytes += block.evidence().size_bytes();
   }
+  // The arena's alignment padding.
+  s.bytes += arena_.bytes_used() - evidence_bytes;
   return s;
 }
 

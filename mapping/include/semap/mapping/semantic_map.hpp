@@ -10,6 +10,7 @@
 
 #include "semap/common/messages.hpp"
 #include "semap/mapping/block.hpp"
+#include "semap/mapping/block_arena.hpp"
 #include "semap/mapping/block_index.hpp"
 #include "semap/mapping/cell_posterior.hpp"
 #include "semap/mapping/kernel.hpp"
@@ -104,6 +105,8 @@ class SemanticMap {
   // blocks_ (a deque, so Block references stay valid while blocks are added).
   VoxelHashMap table_;
   std::vector<BlockIndex> indices_;
+  // Before blocks_: the blocks' evidence lives in it, so it must be destroyed after them.
+  BlockArena arena_;
   std::deque<Block> blocks_;
   std::size_t scans_ = 0;
   std::size_t rejected_ = 0;
