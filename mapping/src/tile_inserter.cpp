@@ -47,7 +47,8 @@ std::int32_t tile_shift_for(const MapParams& params) {
   // Blocks of 8+ cells per side are tiles themselves: a support rarely spans many of them,
   // and the scratch's write-back (n K floats per touched block row) would cost more than
   // it saves at large K.
-  if (block_shift >= kDirectBlockShift) return block_shift;
+  // S-CSM touches one cell per point: nothing to gain from a scratch tile.
+  if (block_shift >= kDirectBlockShift || params.method == Method::kCsm) return block_shift;
   const std::size_t big = std::size_t{32 * 32 * 32} * sizeof(float) * params.num_classes;
   return big <= kScratchBytes ? 5 : 4;
 }
