@@ -11,6 +11,7 @@
 #include <functional>
 #include <vector>
 
+#include "fast_floor.hpp"
 #include "semap/mapping/block.hpp"
 #include "semap/mapping/block_index.hpp"
 #include "semap/mapping/kernel.hpp"
@@ -20,16 +21,6 @@
 #include "voxel_grouping.hpp"
 
 namespace semap::mapping::detail {
-
-// std::floor/ceil are library calls without SSE4.1; these are exact for |x| < 2^31.
-inline std::int32_t fast_floor(float x) {
-  const auto i = static_cast<std::int32_t>(x);
-  return i - static_cast<std::int32_t>(x < static_cast<float>(i));
-}
-inline std::int32_t fast_ceil(float x) {
-  const auto i = static_cast<std::int32_t>(x);
-  return i + static_cast<std::int32_t>(x > static_cast<float>(i));
-}
 
 // Training points and queries are dropped when their cell coordinates could overflow the
 // block keys.

@@ -7,16 +7,17 @@
 #include <stdexcept>
 #include <string>
 
+#include "fast_floor.hpp"
 #include "voxel_grouping.hpp"
 
 namespace semap::mapping {
 
 namespace {
 
+// Only called for keyable points, so the fast floor is exact.
 BlockIndex voxel_of(const Eigen::Vector3f& p, float inv_res) {
-  return {static_cast<std::int32_t>(std::floor(p.x() * inv_res)),
-          static_cast<std::int32_t>(std::floor(p.y() * inv_res)),
-          static_cast<std::int32_t>(std::floor(p.z() * inv_res))};
+  return {detail::fast_floor(p.x() * inv_res), detail::fast_floor(p.y() * inv_res),
+          detail::fast_floor(p.z() * inv_res)};
 }
 
 // Grid coordinates beyond +-2^20 voxels (or NaN) cannot be keyed; reject before flooring.
