@@ -53,6 +53,9 @@ std::int32_t tile_shift_for(const MapParams& params) {
   return big <= kScratchBytes ? 5 : 4;
 }
 
+// Blocks per task when blocks are the tiles.
+constexpr std::size_t kBlocksPerTask = 16;
+
 // Points per parallel chunk of the per-point preparation.
 constexpr std::size_t kPointGrain = 1024;
 
@@ -221,6 +224,11 @@ void TileInserter::group_by_tile(std::size_t count) {
   tile_points_.resize(pairs);
   for (std::size_t j = 0; j < pairs; ++j) tile_points_[fill_[tile_of_pair[j]]++] = pair_points_[j];
   // 5. Blocks of each tile that its points' supports overlap (parallel over tiles).
+  if (tile_shift_ == block_shift_) {
+    // A tile is one block, and every tile has a point.
+    block_masks_.assign(tiles_.size(), 1);
+    return;
+  }
   block_masks_.assign(tiles_.size() * mask_words_, 0);
   tbb::parallel_for(std::size_t{0}, tiles_.size(), [&](std::size_t t) { mark_blocks(t); });
 }
@@ -376,8 +384,11 @@ TileInsertResult TileInserter::insert(const TrainingSet& training, const KernelT
   group_by_tile(training.size());
   // Creating blocks mutates the map's table, so it happens before the parallel part.
   create_blocks(block_at, result);
+  // Scratch tiles are big units of work; blocks written in place are small (S-CSM: a few
+  // points each), so they go in groups to keep the task overhead down.
+  const std::size_t grain = tile_shift_ == block_shift_ ? kBlocksPerTask : 1;
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, tiles_.size(), 1),
+      tbb::blocked_range<std::size_t>(0, tiles_.size(), grain),
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
           process_tile(t, training, kernel);
