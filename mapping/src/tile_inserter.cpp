@@ -4,6 +4,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -61,12 +65,31 @@ constexpr std::size_t kPointGrain = 1024;
 
 // Adds k(d) y_i to every cell of the tile-local `box` whose centre lies within ell of
 // point i and sets their bits in the row masks. `d2[a][c]` is the squared distance along
-// axis a to the centres of local cell box.lo[a] + c; the first `left` cells along x have
-// their centres before the point. Hard labels touch one float per cell.
+// axis a to the centres of local cell box.lo[a] + c (d2[0] readable 8 floats past the box).
+// Hard labels touch one float per cell.
+// Bit x set when dx2[x] < rest, for x < width. With SSE2 and width <= 8 two compares of four
+// lanes; reads 8 floats from dx2 either way in that case, so callers pad the array.
+inline std::uint32_t inside_mask(const float* dx2, std::int32_t width, float rest) {
+#if defined(__SSE2__)
+  if (width <= 8) {
+    const __m128 r = _mm_set1_ps(rest);
+    const auto lo = static_cast<std::uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(dx2), r)));
+    const auto hi =
+        static_cast<std::uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(dx2 + 4), r)));
+    return (lo | hi << 4) & ((std::uint32_t{1} << width) - 1);
+  }
+#endif
+  std::uint32_t mask = 0;
+  for (std::int32_t x = 0; x < width; ++x) {
+    mask |= static_cast<std::uint32_t>(dx2[x] < rest) << x;
+  }
+  return mask;
+}
+
 template <bool kSoft>
 void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& box,
-                  const std::array<const float*, 3>& d2, std::int32_t left,
-                  const TrainingSet& training, std::size_t i, const KernelTable& kernel) {
+                  const std::array<const float*, 3>& d2, const TrainingSet& training, std::size_t i,
+                  const KernelTable& kernel) {
   const auto k = static_cast<std::size_t>(training.num_classes);
   const float ell2 = kernel.ell_squared();
   const float* y = kSoft ? training.probabilities.data() + i * k : nullptr;
@@ -84,16 +107,12 @@ void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& bo
       const float dyz2 = dz2 + d2[1][yy];
       if (dyz2 >= ell2) continue;
       // x is inside when d2x < ell^2 - dyz2; its weight is the tabulated kernel of
-      // dyz2 + d2x. d2x falls towards the point and rises after it, so the inside cells are
-      // the last ones of the first `left` and the first ones of the rest: count them
-      // without branches.
+      // dyz2 + d2x. The inside cells are one run (d2x is convex in x).
       const float rest = ell2 - dyz2;
-      std::int32_t before = 0, after = 0;
-      for (std::int32_t x = 0; x < left; ++x) before += dx2[x] < rest ? 1 : 0;
-      for (std::int32_t x = left; x < width; ++x) after += dx2[x] < rest ? 1 : 0;
-      if (before + after == 0) continue;
-      const std::int32_t x_lo = left - before;
-      const std::int32_t x_hi = left + after - 1;
+      const std::uint32_t mask = inside_mask(dx2, width, rest);
+      if (mask == 0) continue;
+      const std::int32_t x_lo = std::countr_zero(mask);
+      const std::int32_t x_hi = 31 - std::countl_zero(mask);
       if constexpr (kSoft) {
         for (std::int32_t x = x_lo; x <= x_hi; ++x) {
           const float w = lut.inside(dyz2 + dx2[x]);
@@ -106,8 +125,7 @@ void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& bo
           column[static_cast<std::size_t>(x) * k] += lut.inside(dyz2 + dx2[x]);
         }
       }
-      target.mark(first_row + static_cast<std::size_t>(yy),
-                  ((std::uint32_t{2} << (x_hi - x_lo)) - 1) << (x_lo + box.lo[0]), side);
+      target.mark(first_row + static_cast<std::size_t>(yy), mask << box.lo[0], side);
     }
   }
 }
@@ -131,8 +149,8 @@ void TileInserter::prepare_points(const TrainingSet& training) {
   const std::size_t count = training.size();
   boxes_.resize(count);
   bad_.resize(count);
-  distances_.resize(count * 3 * width_);
-  lefts_.resize(count);
+  // Padded so that the row test may read 8 floats from any cell of the last point.
+  distances_.resize(count * 3 * width_ + 8);
   const float inv_res = 1.0f / params_.resolution;
   const std::size_t soft_rows = training.probabilities.size() / params_.num_classes;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
@@ -151,17 +169,14 @@ void TileInserter::prepare_points(const TrainingSet& training) {
                         boxes_[i] = box;
                         if (width_ == 0) continue;
                         float* d2 = distances_.data() + i * 3 * width_;
-                        std::int32_t left = 0;
                         for (int a = 0; a < 3; ++a, d2 += width_) {
                           // Widths never exceed width_ (2 ell / res + 1 at most).
                           for (std::int32_t c = box.lo[a]; c <= box.hi[a]; ++c) {
                             const float d = (static_cast<float>(c) + 0.5f) * params_.resolution -
                                             training.points[i][a];
                             d2[c - box.lo[a]] = d * d;
-                            if (a == 0) left += d < 0.0f ? 1 : 0;
                           }
                         }
-                        lefts_[i] = left;
                       }
                     });
 }
@@ -308,12 +323,10 @@ void TileInserter::scatter_point(const TileTarget& target, const std::array<std:
   const float* first = distances_.data() + i * 3 * width_;
   std::array<const float*, 3> d2{};
   for (int a = 0; a < 3; ++a) d2[a] = first + a * width_ + (base[a] + box.lo[a] - support.lo[a]);
-  const std::int32_t left =
-      std::clamp(lefts_[i] - (base[0] + box.lo[0] - support.lo[0]), 0, box.hi[0] - box.lo[0] + 1);
   if (training.labels[i] >= 0) {
-    smooth_point<false>(target, side, box, d2, left, training, i, kernel);
+    smooth_point<false>(target, side, box, d2, training, i, kernel);
   } else {
-    smooth_point<true>(target, side, box, d2, left, training, i, kernel);
+    smooth_point<true>(target, side, box, d2, training, i, kernel);
   }
 }
 

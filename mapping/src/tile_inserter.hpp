@@ -113,10 +113,9 @@ class TileInserter {
   std::size_t width_;       // distances stored per point and axis
 
   // Per-scan buffers, kept across scans to avoid reallocating them.
-  std::vector<CellBox> boxes_;       // support of each training point (empty if unusable)
-  std::vector<float> distances_;     // S-BKI: squared axis distances, 3 * width_ per point
-  std::vector<std::int32_t> lefts_;  // S-BKI: support cells along x with centres before the point
-  std::vector<std::uint8_t> bad_;    // 1 for rejected points
+  std::vector<CellBox> boxes_;             // support of each training point (empty if unusable)
+  std::vector<float> distances_;           // S-BKI: squared axis distances, 3 * width_ per point
+  std::vector<std::uint8_t> bad_;          // 1 for rejected points
   std::vector<std::uint32_t> pair_first_;  // count + 1: first (point, tile) pair of each point
   std::vector<BlockIndex> pair_tiles_;
   std::vector<std::uint32_t> pair_points_;
