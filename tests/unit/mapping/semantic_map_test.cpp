@@ -251,12 +251,13 @@ TEST(SemanticMap, ToyMapIsMostlyRightAndCompact) {
 // labels, two scans: every cell must hold the sum over points of k(d) y, computed here
 // directly in double precision, for every storage layout the insertion picks (scratch tiles
 // of 32 or 16 cells, blocks written in place, one- and many-word block masks).
-class BkiEqualsBruteForce : public ::testing::TestWithParam<std::tuple<int, int>> {};
+class BkiEqualsBruteForce : public ::testing::TestWithParam<std::tuple<int, int, float>> {};
 
 TEST_P(BkiEqualsBruteForce, EveryCellHoldsTheKernelSum) {
-  const auto [depth, classes] = GetParam();
+  const auto [depth, classes, ell] = GetParam();
   MapParams params = bki_params(classes);
   params.block_depth = depth;
+  params.ell = ell;
   SemanticMap map(params);
   const SparseKernel kernel(params.sf2, params.ell);
   std::mt19937 rng(static_cast<unsigned>(depth * 31 + classes));
@@ -283,9 +284,9 @@ TEST_P(BkiEqualsBruteForce, EveryCellHoldsTheKernelSum) {
     for (std::size_t i = 0; i < t.size(); ++i) {
       const Eigen::Vector3f& p = t.points[i];
       const Eigen::Vector3i c = (p / params.resolution).array().floor().cast<int>();
-      for (int dz = -4; dz <= 4; ++dz) {
-        for (int dy = -4; dy <= 4; ++dy) {
-          for (int dx = -4; dx <= 4; ++dx) {
+      for (int dz = -6; dz <= 6; ++dz) {
+        for (int dy = -6; dy <= 6; ++dy) {
+          for (int dx = -6; dx <= 6; ++dx) {
             const Eigen::Vector3f centre = ((c + Eigen::Vector3i(dx, dy, dz)).cast<float>() +
                                             Eigen::Vector3f::Constant(0.5f)) *
                                            params.resolution;
@@ -318,10 +319,13 @@ TEST_P(BkiEqualsBruteForce, EveryCellHoldsTheKernelSum) {
   EXPECT_GT(checked, 5000u);
 }
 
+// ell 0.3: 6-cell rows; ell 0.5: 10-cell rows, past the 8-lane row test.
 INSTANTIATE_TEST_SUITE_P(Layouts, BkiEqualsBruteForce,
-                         ::testing::Values(std::make_tuple(3, 4), std::make_tuple(3, 20),
-                                           std::make_tuple(2, 3), std::make_tuple(4, 5),
-                                           std::make_tuple(6, 2)));
+                         ::testing::Values(std::make_tuple(3, 4, 0.3f),
+                                           std::make_tuple(3, 20, 0.3f),
+                                           std::make_tuple(2, 3, 0.3f), std::make_tuple(4, 5, 0.3f),
+                                           std::make_tuple(6, 2, 0.3f), std::make_tuple(3, 3, 0.5f),
+                                           std::make_tuple(4, 3, 0.5f)));
 
 TEST(SemanticMap, BadPointsAreCountedNotFatal) {
   SemanticMap map(bki_params());
