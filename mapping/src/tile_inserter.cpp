@@ -120,9 +120,12 @@ void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& bo
           for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
         }
       } else {
+        // Every cell of the row, outside ones weighted 0: the trip count is the same for all
+        // rows of a piece, so the loop exit is predicted (a run's length is not).
         float* column = cells + training.labels[i];
-        for (std::int32_t x = x_lo; x <= x_hi; ++x) {
-          column[static_cast<std::size_t>(x) * k] += lut.inside(dyz2 + dx2[x]);
+        for (std::int32_t x = 0; x < width; ++x) {
+          const float inside = static_cast<float>((mask >> x) & 1u);
+          column[static_cast<std::size_t>(x) * k] += lut.clamped(dyz2 + dx2[x]) * inside;
         }
       }
       target.mark(first_row + static_cast<std::size_t>(yy), mask << box.lo[0], side);

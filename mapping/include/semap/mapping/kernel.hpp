@@ -50,13 +50,20 @@ class KernelTable {
   struct View {
     const float* lines;
     float inv_step;
+    float last;
     float inside(float d2) const {
       const float s = d2 * inv_step;
       const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
       return lines[2 * i] + lines[2 * i + 1] * s;
     }
+    // operator() of the table: 0 beyond ell.
+    float clamped(float d2) const {
+      const float s = std::min(d2 * inv_step, last);
+      const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
+      return lines[2 * i] + lines[2 * i + 1] * s;
+    }
   };
-  View view() const { return {lines_.data(), inv_step_}; }
+  View view() const { return {lines_.data(), inv_step_, last_}; }
 
  private:
   // Interleaved (offset, slope) per step; the entry at s = intervals is (0, 0).
