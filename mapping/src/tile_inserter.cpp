@@ -65,7 +65,7 @@ constexpr std::size_t kPointGrain = 1024;
 
 // Adds k(d) y_i to every cell of the tile-local `box` whose centre lies within ell of
 // point i and sets their bits in the row masks. `d2[a][c]` is the squared distance along
-// axis a to the centres of local cell box.lo[a] + c (d2[0] readable 8 floats past the box).
+// axis a to the centres of local cell box.lo[a] + c (readable 8 floats past the box).
 // Hard labels touch one float per cell.
 // Bit x set when dx2[x] < rest, for x < width. With SSE2 and width <= 8 two compares of four
 // lanes; reads 8 floats from dx2 either way in that case, so callers pad the array.
@@ -101,11 +101,17 @@ void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& bo
   const std::size_t row_stride = static_cast<std::size_t>(side) * k;
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
     const float dz2 = d2[2][z - box.lo[2]];
+    // Rows whose centre line passes within ell: again one run, found without branches. At
+    // its ends rounding may leave dyz2 >= ell^2; those rows then have no inside cell.
+    const std::uint32_t rows_inside = inside_mask(d2[1], box.hi[1] - box.lo[1] + 1, ell2 - dz2);
+    if (rows_inside == 0) continue;
+    const std::int32_t y_first = std::countr_zero(rows_inside);
+    const std::int32_t y_last = 31 - std::countl_zero(rows_inside);
     const std::size_t first_row = static_cast<std::size_t>(z * side + box.lo[1]);
-    float* cells = target.evidence + (first_row * side + static_cast<std::size_t>(box.lo[0])) * k;
-    for (std::int32_t yy = 0; yy <= box.hi[1] - box.lo[1]; ++yy, cells += row_stride) {
+    float* cells = target.evidence + (first_row * side + static_cast<std::size_t>(box.lo[0])) * k +
+                   static_cast<std::size_t>(y_first) * row_stride;
+    for (std::int32_t yy = y_first; yy <= y_last; ++yy, cells += row_stride) {
       const float dyz2 = dz2 + d2[1][yy];
-      if (dyz2 >= ell2) continue;
       // x is inside when d2x < ell^2 - dyz2; its weight is the tabulated kernel of
       // dyz2 + d2x. The inside cells are one run (d2x is convex in x).
       const float rest = ell2 - dyz2;
