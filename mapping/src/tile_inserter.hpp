@@ -17,7 +17,6 @@
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/training_data.hpp"
-#include "semap/mapping/voxel_hash_map.hpp"
 #include "voxel_grouping.hpp"
 
 namespace semap::mapping::detail {
@@ -60,16 +59,17 @@ struct TileInsertResult {
   std::vector<BlockIndex> updated_blocks;
 };
 
-// A tile is a cube of tile_side cells (16, or one block when blocks are larger): the unit of
-// parallel work. A training point's support (6 cells wide for the toy run) overlaps about
-// 2.3 tiles instead of about 11 blocks of 4 cells, so the per-(point, piece) clipping runs
-// a fifth as often, and the scatter loop writes into a dense per-thread scratch tile (same
-// cell-major layout as a block) instead of finding the block of every row.
+// A tile is a cube of cells, the unit of parallel work: 32 cells per side (16 when such a
+// scratch tile of K classes would exceed 512 KiB), or exactly one block when blocks have 8 or
+// more cells per side, and for S-CSM. A toy training point's support (6 cells wide) reaches
+// about 1.6 tiles of 32 instead of about 11 blocks of 4 cells, so the per-(point, piece)
+// clipping runs far less often, and the scatter loop writes into a dense per-thread scratch
+// tile (same cell-major layout as a block) instead of finding the block of every row.
 //
-// Every tile is processed by one task that visits its points in input order, adds their
-// weights into the zeroed scratch, then adds the scratch to the tile's blocks and zeroes it
-// again. Per cell this is evidence + (sum of this scan's weights in input order), whatever
-// the thread count.
+// Every tile is processed by one task that visits its points in input order. With a scratch
+// tile it adds their weights into the zeroed scratch, then adds the scratch to the tile's
+// blocks and zeroes it again: per cell, evidence + (this scan's weights summed in input
+// order). A one-block tile is written in place. Neither depends on the thread count.
 class TileInserter {
  public:
   using BlockAt = std::function<Block&(const BlockIndex&)>;
