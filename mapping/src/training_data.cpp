@@ -90,9 +90,8 @@ void downsample_hits(const common::LabeledCloud& cloud, const Eigen::Vector3f& o
   std::vector<Centroid> centroids(voxels);
   // Per voxel: label counts (hard) or probability sums (soft), K floats each.
   std::vector<float> votes(voxels * static_cast<std::size_t>(k), 0.0f);
-  // Input order per voxel, as a serial pass would sum.
-  for (std::size_t i = 0; i < n; ++i) {
-    if (status[i] != 0) continue;
+  // Input order per voxel, as a serial pass would sum; voxel sets in parallel.
+  grouping.for_each_item([&](std::size_t i) {
     const std::uint32_t id = voxel_of_point[i];
     centroids[id].sum += cloud.points[i];
     ++centroids[id].count;
@@ -103,7 +102,7 @@ void downsample_hits(const common::LabeledCloud& cloud, const Eigen::Vector3f& o
     } else {
       v[cloud.labels[i]] += 1.0f;
     }
-  }
+  });
   out.points.reserve(voxels);
   out.labels.reserve(voxels);
   if (soft) out.probabilities.reserve(voxels * static_cast<std::size_t>(k));
@@ -166,11 +165,11 @@ void add_free_samples(const Eigen::Vector3f& origin, const MapParams& params, Tr
   grouping.group(keys, {});
   const auto voxel_of_sample = grouping.voxel_of();
   std::vector<Centroid> centroids(grouping.voxels());
-  for (std::size_t j = 0; j < items; ++j) {
+  grouping.for_each_item([&](std::size_t j) {
     Centroid& c = centroids[voxel_of_sample[j]];
     c.sum += samples[j];
     ++c.count;
-  }
+  });
   out.points.reserve(out.points.size() + centroids.size());
   out.labels.reserve(out.labels.size() + centroids.size());
   for (const Centroid& c : centroids) {

@@ -33,10 +33,15 @@ void VoxelGrouping::group(std::span<const BlockIndex> keys, std::span<const std:
   const auto skipped = [&](std::size_t i) { return !skip.empty() && skip[i] != 0; };
   if (n < kParallelItems) {
     VoxelHashMap ids(n / 2 + 16);
+    items_.clear();
     for (std::size_t i = 0; i < n; ++i) {
-      if (!skipped(i)) voxel_[i] = ids.insert(keys[i]);
+      if (skipped(i)) continue;
+      voxel_[i] = ids.insert(keys[i]);
+      items_.push_back(static_cast<std::uint32_t>(i));
     }
     voxels_ = ids.size();
+    // One set holding every item.
+    offsets_.assign({0, static_cast<std::uint32_t>(items_.size())});
     return;
   }
   shard_.resize(n);

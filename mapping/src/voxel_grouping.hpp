@@ -2,6 +2,8 @@
 
 // Internal to semap_mapping: parallel grouping of points by voxel for the training-set build.
 
+#include <tbb/parallel_for.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -26,6 +28,15 @@ class VoxelGrouping {
 
   std::span<const std::uint32_t> voxel_of() const { return voxel_; }
   std::size_t voxels() const { return voxels_; }
+
+  // Calls f(item) for every grouped item, in parallel over disjoint sets of voxels and in
+  // ascending item order within each, so per-voxel sums come out as a serial pass's.
+  template <typename F>
+  void for_each_item(F&& f) const {
+    tbb::parallel_for(std::size_t{0}, offsets_.size() - 1, [&](std::size_t s) {
+      for (std::uint32_t j = offsets_[s]; j < offsets_[s + 1]; ++j) f(items_[j]);
+    });
+  }
 
  private:
   std::vector<std::uint32_t> voxel_;                // per item: shard-local, then global number
