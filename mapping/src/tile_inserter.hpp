@@ -127,6 +127,7 @@ class TileInserter {
   std::vector<std::uint32_t> fill_;
   std::vector<std::uint32_t> block_offsets_;  // tiles_.size() + 1, into tile_blocks_
   std::vector<TileBlock> tile_blocks_;
+  std::vector<std::uint32_t> order_;  // tiles in processing order
   tbb::enumerable_thread_specific<Scratch> scratch_;
 };
 
