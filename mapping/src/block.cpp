@@ -16,11 +16,18 @@ std::size_t words_for(int cells) { return (static_cast<std::size_t>(cells) + 63)
 Block::Block(int cells_per_side, int num_classes)
     : n_(cells_per_side),
       k_(num_classes),
-      evidence_(static_cast<float*>(
-          std::calloc(static_cast<std::size_t>(num_cells()) * num_classes, sizeof(float)))),
+      evidence_(static_cast<float*>(std::calloc(static_cast<std::size_t>(num_cells()) * num_classes,
+                                                sizeof(float))),
+                FreeDeleter{true}),
       observed_(new std::uint64_t[words_for(num_cells())]()) {
   if (!evidence_) throw std::bad_alloc();
 }
+
+Block::Block(int cells_per_side, int num_classes, float* storage)
+    : n_(cells_per_side),
+      k_(num_classes),
+      evidence_(storage, FreeDeleter{false}),
+      observed_(new std::uint64_t[words_for(num_cells())]()) {}
 
 std::span<const float> Block::evidence() const {
   return {evidence_.get(), static_cast<std::size_t>(num_cells()) * k_};

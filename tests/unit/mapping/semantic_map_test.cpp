@@ -247,6 +247,86 @@ TEST(SemanticMap, ToyMapIsMostlyRightAndCompact) {
   EXPECT_EQ(stats.scans, 12u);
 }
 
+// Many points across tile and block boundaries (negative coordinates too), hard and soft
+// labels, two scans: every cell must hold the sum over points of k(d) y, computed here
+// directly in double precision, for every storage layout the insertion picks (scratch tiles
+// of 32 or 16 cells, blocks written in place, one- and many-word block masks).
+class BkiEqualsBruteForce : public ::testing::TestWithParam<std::tuple<int, int, float>> {};
+
+TEST_P(BkiEqualsBruteForce, EveryCellHoldsTheKernelSum) {
+  const auto [depth, classes, ell] = GetParam();
+  MapParams params = bki_params(classes);
+  params.block_depth = depth;
+  params.ell = ell;
+  SemanticMap map(params);
+  const SparseKernel kernel(params.sf2, params.ell);
+  std::mt19937 rng(static_cast<unsigned>(depth * 31 + classes));
+  std::uniform_real_distribution<float> coord(-1.7f, 1.9f);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::map<CellKey, std::vector<double>> expected;
+  for (int scan = 0; scan < 2; ++scan) {
+    TrainingSet t;
+    t.num_classes = classes;
+    for (int i = 0; i < 150; ++i) {
+      t.points.emplace_back(coord(rng), coord(rng), coord(rng));
+      const bool soft = i < 40;
+      t.labels.push_back(soft ? TrainingSet::kSoft : static_cast<int>(i % classes));
+      if (soft) {
+        float sum = 0.0f;
+        std::vector<float> y(static_cast<std::size_t>(classes));
+        for (float& v : y) sum += (v = unit(rng) + 0.01f);
+        for (float& v : y) t.probabilities.push_back(v / sum);
+      }
+    }
+    // Soft rows first: probabilities row i belongs to point i.
+    t.num_hits = t.points.size();
+    map.insert(t);
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const Eigen::Vector3f& p = t.points[i];
+      const Eigen::Vector3i c = (p / params.resolution).array().floor().cast<int>();
+      for (int dz = -6; dz <= 6; ++dz) {
+        for (int dy = -6; dy <= 6; ++dy) {
+          for (int dx = -6; dx <= 6; ++dx) {
+            const Eigen::Vector3f centre = ((c + Eigen::Vector3i(dx, dy, dz)).cast<float>() +
+                                            Eigen::Vector3f::Constant(0.5f)) *
+                                           params.resolution;
+            const double w = kernel((centre - p).cast<double>().norm());
+            if (w == 0.0) continue;
+            auto& e = expected[{c.x() + dx, c.y() + dy, c.z() + dz}];
+            e.resize(static_cast<std::size_t>(classes), 0.0);
+            for (int k = 0; k < classes; ++k) {
+              const double y = t.labels[i] >= 0 ? (t.labels[i] == k ? 1.0 : 0.0)
+                                                : t.probabilities[i * classes + k];
+              e[static_cast<std::size_t>(k)] += w * y;
+            }
+          }
+        }
+      }
+    }
+  }
+  std::size_t checked = 0;
+  for (const auto& [key, evidence] : all_cells(map)) {
+    const auto it = expected.find(key);
+    for (int k = 0; k < classes; ++k) {
+      const double want = it == expected.end() ? 0.0 : it->second[static_cast<std::size_t>(k)];
+      // Table error 1e-5 sf2 per point; up to about 30 points reach a cell.
+      ASSERT_NEAR(evidence[static_cast<std::size_t>(k)], want, 3e-4 * params.sf2)
+          << std::get<0>(key) << "," << std::get<1>(key) << "," << std::get<2>(key);
+    }
+    checked += it != expected.end();
+  }
+  EXPECT_EQ(checked, expected.size());
+  EXPECT_GT(checked, 5000u);
+}
+
+// ell 0.3: 6-cell rows; ell 0.5: 10-cell rows, past the 8-lane row test.
+INSTANTIATE_TEST_SUITE_P(Layouts, BkiEqualsBruteForce,
+                         ::testing::Values(std::make_tuple(3, 4, 0.3f),
+                                           std::make_tuple(3, 20, 0.3f),
+                                           std::make_tuple(2, 3, 0.3f), std::make_tuple(4, 5, 0.3f),
+                                           std::make_tuple(6, 2, 0.3f), std::make_tuple(3, 3, 0.5f),
+                                           std::make_tuple(4, 3, 0.5f)));
+
 TEST(SemanticMap, BadPointsAreCountedNotFatal) {
   SemanticMap map(bki_params());
   common::LabeledCloud c;

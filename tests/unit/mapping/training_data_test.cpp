@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <random>
+#include <tuple>
 
 namespace semap::mapping {
 namespace {
@@ -94,6 +97,80 @@ TEST(TrainingData, SoftLabelsAverageTheProbabilityVectors) {
 TEST(TrainingData, MismatchedLabelArraysAreAnError) {
   const auto cloud = cloud_of({{1, 0, 0}, {2, 0, 0}}, {1});
   EXPECT_THROW(build_training_set(cloud, Eigen::Vector3f::Zero(), params()), std::invalid_argument);
+}
+
+// A scan large enough for the parallel build (sharded voxel grouping): hits and free samples
+// must come out exactly as one serial pass makes them, which this test does directly.
+TEST(TrainingData, LargeScanEqualsTheSerialDefinition) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> coord(-6.0f, 6.0f);
+  std::uniform_int_distribution<int> label(1, 3);
+  common::LabeledCloud cloud;
+  for (int i = 0; i < 60000; ++i) {
+    cloud.points.emplace_back(coord(rng), coord(rng), coord(rng) * 0.2f);
+    cloud.labels.push_back(static_cast<std::uint16_t>(label(rng)));
+  }
+  const Eigen::Vector3f origin(0.05f, 0.05f, 0.05f);
+  MapParams p = params();
+  p.free_res = 0.3f;
+  const TrainingSet set = build_training_set(cloud, origin, p);
+
+  // Voxels in order of first occurrence; sums in input order.
+  using Key = std::tuple<int, int, int>;
+  const auto key = [](const Eigen::Vector3f& v) {
+    const float inv = 1.0f / 0.1f;
+    return Key{static_cast<int>(std::floor(v.x() * inv)), static_cast<int>(std::floor(v.y() * inv)),
+               static_cast<int>(std::floor(v.z() * inv))};
+  };
+  struct Voxel {
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    std::uint32_t count = 0;
+    std::array<float, 4> votes{};
+  };
+  std::map<Key, std::size_t> index;
+  std::vector<Voxel> hits;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto [it, fresh] = index.try_emplace(key(cloud.points[i]), hits.size());
+    if (fresh) hits.emplace_back();
+    Voxel& v = hits[it->second];
+    v.sum += cloud.points[i];
+    ++v.count;
+    v.votes[cloud.labels[i]] += 1.0f;
+  }
+  ASSERT_EQ(set.num_hits, hits.size());
+  ASSERT_GT(hits.size(), 30000u);
+  std::vector<Eigen::Vector3f> hit_points;
+  for (std::size_t h = 0; h < hits.size(); ++h) {
+    const Eigen::Vector3f c = hits[h].sum / static_cast<float>(hits[h].count);
+    hit_points.push_back(c);
+    ASSERT_EQ(set.points[h], c) << h;
+    const auto& votes = hits[h].votes;
+    ASSERT_EQ(set.labels[h], std::max_element(votes.begin(), votes.end()) - votes.begin()) << h;
+  }
+  // Free samples: the origin, then every free_res along each downsampled hit's beam.
+  index.clear();
+  std::vector<Voxel> free;
+  const auto add = [&](const Eigen::Vector3f& q) {
+    const auto [it, fresh] = index.try_emplace(key(q), free.size());
+    if (fresh) free.emplace_back();
+    free[it->second].sum += q;
+    ++free[it->second].count;
+  };
+  add(origin);
+  for (const Eigen::Vector3f& hit : hit_points) {
+    const Eigen::Vector3f ray = hit - origin;
+    const float length = ray.norm();
+    if (!(length > p.free_res)) continue;
+    const Eigen::Vector3f dir = ray / length;
+    const int samples = static_cast<int>(std::floor((length - p.free_res) / p.free_res));
+    for (int s = 1; s <= samples; ++s) add(origin + dir * (p.free_res * static_cast<float>(s)));
+  }
+  ASSERT_EQ(set.size(), hits.size() + free.size());
+  ASSERT_GT(free.size(), 30000u);
+  for (std::size_t f = 0; f < free.size(); ++f) {
+    ASSERT_EQ(set.points[hits.size() + f], free[f].sum / static_cast<float>(free[f].count)) << f;
+    ASSERT_EQ(set.labels[hits.size() + f], 0);
+  }
 }
 
 }  // namespace

@@ -16,6 +16,9 @@ namespace semap::mapping {
 class Block {
  public:
   Block(int cells_per_side, int num_classes);
+  // Evidence in `storage` (cells * K zeroed floats), owned by the caller and outliving the
+  // block (SemanticMap's BlockArena).
+  Block(int cells_per_side, int num_classes, float* storage);
 
   int cells_per_side() const { return n_; }
   int num_cells() const { return n_ * n_ * n_; }
@@ -41,14 +44,17 @@ class Block {
   // more than zero become observed. This is how maps are merged.
   void add_evidence(std::span<const float> evidence);
 
-  // Heap bytes owned by this block (evidence, observed bits and the object itself).
+  // Bytes of this block (evidence, observed bits and the object itself).
   std::size_t bytes() const;
 
  private:
   // calloc'd: fresh pages arrive zeroed from the kernel, so a new block costs no memset and
   // its first touch happens in the (parallel) update rather than at creation.
   struct FreeDeleter {
-    void operator()(float* p) const { std::free(p); }
+    bool owned = true;
+    void operator()(float* p) const {
+      if (owned) std::free(p);
+    }
   };
 
   int n_;

@@ -34,21 +34,30 @@ class KernelTable {
   explicit KernelTable(const SparseKernel& kernel, int intervals = 1024);
 
   // k at squared distance d2; exactly 0 for d2 >= ell^2.
-  float operator()(float d2) const {
-    const float s = std::min(d2 * inv_step_, last_);
-    const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
-    return lines_[2 * i] + lines_[2 * i + 1] * s;
-  }
-
-  // Same value as operator(), without the clamp, for d2 known to be below ell^2 up to
-  // rounding: there d2 / step stays below intervals + 1, whose entry (0, 0) gives exactly 0.
-  float inside(float d2) const {
-    const float s = d2 * inv_step_;
-    const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
-    return lines_[2 * i] + lines_[2 * i + 1] * s;
-  }
+  float operator()(float d2) const { return view().clamped(d2); }
 
   float ell_squared() const { return ell2_; }
+
+  // The table by value, for hot loops. inside() is operator() without the clamp, for d2
+  // known to be below ell^2 up to rounding: there d2 / step stays below intervals + 1, whose
+  // entry (0, 0) gives exactly 0.
+  struct View {
+    const float* lines;
+    float inv_step;
+    float last;
+    float inside(float d2) const {
+      const float s = d2 * inv_step;
+      const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
+      return lines[2 * i] + lines[2 * i + 1] * s;
+    }
+    // operator() of the table: 0 beyond ell.
+    float clamped(float d2) const {
+      const float s = std::min(d2 * inv_step, last);
+      const auto i = static_cast<std::size_t>(static_cast<std::int32_t>(s));
+      return lines[2 * i] + lines[2 * i + 1] * s;
+    }
+  };
+  View view() const { return {lines_.data(), inv_step_, last_}; }
 
  private:
   // Interleaved (offset, slope) per step; the entry at s = intervals is (0, 0).

@@ -10,6 +10,7 @@
 
 #include "semap/common/messages.hpp"
 #include "semap/mapping/block.hpp"
+#include "semap/mapping/block_arena.hpp"
 #include "semap/mapping/block_index.hpp"
 #include "semap/mapping/cell_posterior.hpp"
 #include "semap/mapping/kernel.hpp"
@@ -18,6 +19,10 @@
 #include "semap/mapping/voxel_hash_map.hpp"
 
 namespace semap::mapping {
+
+namespace detail {
+class TileInserter;
+}  // namespace detail
 
 struct MapStats {
   std::size_t blocks = 0;
@@ -48,6 +53,9 @@ struct InsertResult {
 class SemanticMap {
  public:
   explicit SemanticMap(const MapParams& params);
+  ~SemanticMap();
+  SemanticMap(SemanticMap&&) noexcept;
+  SemanticMap& operator=(SemanticMap&&) noexcept;
 
   const MapParams& params() const { return params_; }
 
@@ -97,9 +105,13 @@ class SemanticMap {
   // blocks_ (a deque, so Block references stay valid while blocks are added).
   VoxelHashMap table_;
   std::vector<BlockIndex> indices_;
+  // Before blocks_: the blocks' evidence lives in it, so it must be destroyed after them.
+  BlockArena arena_;
   std::deque<Block> blocks_;
   std::size_t scans_ = 0;
   std::size_t rejected_ = 0;
+  // Insertion engine with its per-scan buffers and per-thread scratch, reused across scans.
+  std::unique_ptr<detail::TileInserter> inserter_;
 };
 
 }  // namespace semap::mapping

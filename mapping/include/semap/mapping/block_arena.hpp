@@ -1,0 +1,40 @@
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace semap::mapping {
+
+// Zeroed storage for block evidence, carved from large anonymous mappings. A LiDAR scan
+// allocates about 100 MB of new blocks; from malloc that is one page fault per 4 KiB (about
+// 40 % of the insertion's CPU time). The mappings ask for transparent huge pages where the
+// kernel offers them (512 times fewer faults) and arrive zeroed, so new blocks cost no memset.
+// Storage lives until the arena is destroyed; it is not movable piecewise.
+class BlockArena {
+ public:
+  BlockArena() = default;
+  ~BlockArena();
+  BlockArena(const BlockArena&) = delete;
+  BlockArena& operator=(const BlockArena&) = delete;
+  BlockArena(BlockArena&& other) noexcept;
+  BlockArena& operator=(BlockArena&& other) noexcept;
+
+  // `floats` zeroed floats, 64-byte aligned. Throws std::bad_alloc when the system refuses.
+  float* allocate(std::size_t floats);
+
+  // Bytes handed out so far (what the blocks use, without the mappings' unused tails).
+  std::size_t bytes_used() const { return used_total_; }
+
+ private:
+  struct Chunk {
+    void* base;
+    std::size_t size;
+  };
+  void release();
+
+  std::vector<Chunk> chunks_;
+  std::size_t used_ = 0;  // bytes used in the last chunk
+  std::size_t used_total_ = 0;
+};
+
+}  // namespace semap::mapping

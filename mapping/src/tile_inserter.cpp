@@ -1,0 +1,434 @@
+#include "tile_inserter.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+
+namespace semap::mapping::detail {
+
+namespace {
+
+// Cells a training point touches: for S-BKI all cells whose centre lies within ell per
+// axis (rows are trimmed to the sphere in the scatter loop), for S-CSM the cell containing
+// the point.
+CellBox support_of(const Eigen::Vector3f& p, const MapParams& params) {
+  const float inv_res = 1.0f / params.resolution;
+  CellBox box{};
+  for (int a = 0; a < 3; ++a) {
+    if (params.method == Method::kCsm) {
+      box.lo[a] = box.hi[a] = fast_floor(p[a] * inv_res);
+    } else {
+      box.lo[a] = fast_ceil((p[a] - params.ell) * inv_res - 0.5f);
+      box.hi[a] = fast_floor((p[a] + params.ell) * inv_res - 0.5f);
+    }
+  }
+  return box;
+}
+
+bool empty(const CellBox& box) {
+  return box.lo[0] > box.hi[0] || box.lo[1] > box.hi[1] || box.lo[2] > box.hi[2];
+}
+
+constexpr CellBox kEmptyBox{{0, 0, 0}, {-1, -1, -1}};
+
+// Scratch tiles are 32 cells per side when that fits in kScratchBytes (K <= 4), else 16: big
+// enough that most supports fit in one (fewer pieces and split rows), small enough that the
+// scratch stays in L2 (K = 4: 512 KiB; K = 20: 16^3 cells, 320 KiB). A toy scan then has
+// 8..18 tiles, one often holding 40 % of the work, so tiles are processed busiest first;
+// 16-cell tiles (10..45 per scan) balance better but cost 8 % more time on one core.
+constexpr std::size_t kScratchBytes = 512 * 1024;
+constexpr std::int32_t kDirectBlockShift = 3;
+
+std::int32_t tile_shift_for(const MapParams& params) {
+  const std::int32_t block_shift = params.block_depth - 1;
+  // Blocks of 8+ cells per side are tiles themselves: a support rarely spans many of them,
+  // and the scratch's write-back (n K floats per touched block row) would cost more than
+  // it saves at large K. S-CSM touches one cell per point: nothing to gain from a scratch.
+  if (block_shift >= kDirectBlockShift || params.method == Method::kCsm) return block_shift;
+  const std::size_t big = std::size_t{32 * 32 * 32} * sizeof(float) * params.num_classes;
+  return big <= kScratchBytes ? 5 : 4;
+}
+
+// Blocks per task when blocks are the tiles.
+constexpr std::size_t kBlocksPerTask = 16;
+
+// Points per parallel chunk of the per-point preparation.
+constexpr std::size_t kPointGrain = 1024;
+
+// Adds k(d) y_i to every cell of the tile-local `box` whose centre lies within ell of
+// point i and sets their bits in the row masks. `d2[a][c]` is the squared distance along
+// axis a to the centres of local cell box.lo[a] + c (readable 8 floats past the box).
+// Hard labels touch one float per cell.
+// Bit x set when dx2[x] < rest, for x < width. With SSE2 and width <= 8 two compares of four
+// lanes; reads 8 floats from dx2 either way in that case, so callers pad the array.
+inline std::uint32_t inside_mask(const float* dx2, std::int32_t width, float rest) {
+#if defined(__SSE2__)
+  if (width <= 8) {
+    const __m128 r = _mm_set1_ps(rest);
+    const auto lo = static_cast<std::uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(dx2), r)));
+    const auto hi =
+        static_cast<std::uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(dx2 + 4), r)));
+    return (lo | hi << 4) & ((std::uint32_t{1} << width) - 1);
+  }
+#endif
+  std::uint32_t mask = 0;
+  for (std::int32_t x = 0; x < width; ++x) {
+    mask |= static_cast<std::uint32_t>(dx2[x] < rest) << x;
+  }
+  return mask;
+}
+
+template <bool kSoft>
+void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& box,
+                  const std::array<const float*, 3>& d2, const TrainingSet& training, std::size_t i,
+                  const KernelTable& kernel) {
+  const auto k = static_cast<std::size_t>(training.num_classes);
+  const float ell2 = kernel.ell_squared();
+  const float* y = kSoft ? training.probabilities.data() + i * k : nullptr;
+  const std::int32_t width = box.hi[0] - box.lo[0] + 1;
+  const float* dx2 = d2[0];
+  // A copy in registers: the stores below would otherwise make the compiler reload the
+  // table's pointer for every cell.
+  const KernelTable::View lut = kernel.view();
+  const std::size_t row_stride = static_cast<std::size_t>(side) * k;
+  for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
+    const float dz2 = d2[2][z - box.lo[2]];
+    // Rows whose centre line passes within ell: again one run, found without branches. At
+    // its ends rounding may leave dyz2 >= ell^2; those rows then have no inside cell.
+    const std::uint32_t rows_inside = inside_mask(d2[1], box.hi[1] - box.lo[1] + 1, ell2 - dz2);
+    if (rows_inside == 0) continue;
+    const std::int32_t y_first = std::countr_zero(rows_inside);
+    const std::int32_t y_last = 31 - std::countl_zero(rows_inside);
+    const std::size_t first_row = static_cast<std::size_t>(z * side + box.lo[1]);
+    float* cells = target.evidence + (first_row * side + static_cast<std::size_t>(box.lo[0])) * k +
+                   static_cast<std::size_t>(y_first) * row_stride;
+    for (std::int32_t yy = y_first; yy <= y_last; ++yy, cells += row_stride) {
+      const float dyz2 = dz2 + d2[1][yy];
+      // x is inside when d2x < ell^2 - dyz2; its weight is the tabulated kernel of
+      // dyz2 + d2x. The inside cells are one run (d2x is convex in x).
+      const float rest = ell2 - dyz2;
+      const std::uint32_t mask = inside_mask(dx2, width, rest);
+      if (mask == 0) continue;
+      const std::int32_t x_lo = std::countr_zero(mask);
+      const std::int32_t x_hi = 31 - std::countl_zero(mask);
+      if constexpr (kSoft) {
+        for (std::int32_t x = x_lo; x <= x_hi; ++x) {
+          const float w = lut.inside(dyz2 + dx2[x]);
+          float* alpha = cells + static_cast<std::size_t>(x) * k;
+          for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
+        }
+      } else {
+        // Every cell of the row, outside ones weighted 0: the trip count is the same for all
+        // rows of a piece, so the loop exit is predicted (a run's length is not).
+        float* column = cells + training.labels[i];
+        for (std::int32_t x = 0; x < width; ++x) {
+          const float inside = static_cast<float>((mask >> x) & 1u);
+          column[static_cast<std::size_t>(x) * k] += lut.clamped(dyz2 + dx2[x]) * inside;
+        }
+      }
+      target.mark(first_row + static_cast<std::size_t>(yy), mask << box.lo[0], side);
+    }
+  }
+}
+
+}  // namespace
+
+TileInserter::TileInserter(const MapParams& params)
+    : params_(params),
+      block_shift_(params.block_depth - 1),
+      tile_shift_(tile_shift_for(params)),
+      blocks_per_tile_side_(1 << (tile_shift_ - block_shift_)),
+      mask_words_((static_cast<std::size_t>(blocks_per_tile_side_) * blocks_per_tile_side_ *
+                       blocks_per_tile_side_ +
+                   63) /
+                  64),
+      width_(params.method == Method::kCsm
+                 ? 0
+                 : static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 3) {}
+
+void TileInserter::prepare_points(const TrainingSet& training) {
+  const std::size_t count = training.size();
+  boxes_.resize(count);
+  bad_.resize(count);
+  // Padded so that the row test may read 8 floats from any cell of the last point.
+  distances_.resize(count * 3 * width_ + 8);
+  const float inv_res = 1.0f / params_.resolution;
+  const std::size_t soft_rows = training.probabilities.size() / params_.num_classes;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const std::int32_t label = training.labels[i];
+                        const bool label_ok =
+                            label >= 0 ? label < params_.num_classes : i < soft_rows;
+                        if (!label_ok || !mappable(training.points[i], inv_res)) {
+                          bad_[i] = 1;
+                          boxes_[i] = kEmptyBox;
+                          continue;
+                        }
+                        bad_[i] = 0;
+                        const CellBox box = support_of(training.points[i], params_);
+                        boxes_[i] = box;
+                        if (width_ == 0) continue;
+                        float* d2 = distances_.data() + i * 3 * width_;
+                        for (int a = 0; a < 3; ++a, d2 += width_) {
+                          // Widths never exceed width_ (2 ell / res + 1 at most).
+                          for (std::int32_t c = box.lo[a]; c <= box.hi[a]; ++c) {
+                            const float d = (static_cast<float>(c) + 0.5f) * params_.resolution -
+                                            training.points[i][a];
+                            d2[c - box.lo[a]] = d * d;
+                          }
+                        }
+                      }
+                    });
+}
+
+void TileInserter::group_by_tile(std::size_t count) {
+  const std::int32_t ts = tile_shift_;
+  // 1. Tiles per point (parallel), then where each point's (point, tile) pairs start.
+  pair_first_.assign(count + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const CellBox& box = boxes_[i];
+                        std::uint32_t tiles = empty(box) ? 0 : 1;
+                        for (int a = 0; a < 3 && tiles; ++a) {
+                          tiles *=
+                              static_cast<std::uint32_t>((box.hi[a] >> ts) - (box.lo[a] >> ts) + 1);
+                        }
+                        pair_first_[i + 1] = tiles;
+                      }
+                    });
+  for (std::size_t i = 0; i < count; ++i) pair_first_[i + 1] += pair_first_[i];
+  const std::size_t pairs = pair_first_[count];
+  // 2. The tile of every pair, in point order (parallel).
+  pair_tiles_.resize(pairs);
+  pair_points_.resize(pairs);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const CellBox& box = boxes_[i];
+                        std::size_t j = pair_first_[i];
+                        if (j == pair_first_[i + 1]) continue;
+                        for (std::int32_t tz = box.lo[2] >> ts; tz <= box.hi[2] >> ts; ++tz) {
+                          for (std::int32_t ty = box.lo[1] >> ts; ty <= box.hi[1] >> ts; ++ty) {
+                            for (std::int32_t tx = box.lo[0] >> ts; tx <= box.hi[0] >> ts;
+                                 ++tx, ++j) {
+                              pair_tiles_[j] = BlockIndex{tx, ty, tz};
+                              pair_points_[j] = static_cast<std::uint32_t>(i);
+                            }
+                          }
+                        }
+                      }
+                    });
+  // 3. Tiles numbered by first occurrence (parallel shards for large scans).
+  tile_grouping_.group(pair_tiles_, {});
+  const auto tile_of_pair = tile_grouping_.voxel_of();
+  tiles_.clear();
+  std::vector<std::uint32_t>& counts = fill_;
+  counts.assign(tile_grouping_.voxels(), 0);
+  for (std::size_t j = 0; j < pairs; ++j) {
+    const std::uint32_t id = tile_of_pair[j];
+    if (id == tiles_.size()) tiles_.push_back(pair_tiles_[j]);
+    ++counts[id];
+  }
+  // 4. Counting sort: each tile's points in ascending order.
+  tile_offsets_.assign(tiles_.size() + 1, 0);
+  for (std::size_t t = 0; t < tiles_.size(); ++t) {
+    tile_offsets_[t + 1] = tile_offsets_[t] + counts[t];
+  }
+  fill_.assign(tile_offsets_.begin(), tile_offsets_.end() - 1);
+  tile_points_.resize(pairs);
+  for (std::size_t j = 0; j < pairs; ++j) tile_points_[fill_[tile_of_pair[j]]++] = pair_points_[j];
+  // 5. Blocks of each tile that its points' supports overlap (parallel over tiles).
+  if (tile_shift_ == block_shift_) {
+    // A tile is one block, and every tile has a point.
+    block_masks_.assign(tiles_.size(), 1);
+    return;
+  }
+  block_masks_.assign(tiles_.size() * mask_words_, 0);
+  tbb::parallel_for(std::size_t{0}, tiles_.size(), [&](std::size_t t) { mark_blocks(t); });
+}
+
+void TileInserter::mark_blocks(std::size_t tile) {
+  const std::int32_t ts = tile_shift_;
+  const std::int32_t bs = block_shift_;
+  const std::int32_t t_side = blocks_per_tile_side_;
+  const std::array<std::int32_t, 3> t{tiles_[tile].x, tiles_[tile].y, tiles_[tile].z};
+  std::uint64_t* mask = block_masks_.data() + tile * mask_words_;
+  for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
+    const CellBox& box = boxes_[tile_points_[p]];
+    // Blocks of this tile that the support overlaps, in tile-local block units.
+    std::array<std::int32_t, 3> blo{}, bhi{};
+    for (int a = 0; a < 3; ++a) {
+      const std::int32_t first = t[a] << ts;
+      const std::int32_t last = first + (1 << ts) - 1;
+      blo[a] = (std::max(box.lo[a], first) - first) >> bs;
+      bhi[a] = (std::min(box.hi[a], last) - first) >> bs;
+    }
+    const std::uint64_t xbits =
+        ((std::uint64_t{2} << bhi[0]) - 1) & ~((std::uint64_t{1} << blo[0]) - 1);
+    for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) {
+      for (std::int32_t by = blo[1]; by <= bhi[1]; ++by) {
+        // A row of t_side <= 16 bits starts at a multiple of t_side: one word.
+        const auto bit = static_cast<std::size_t>((bz * t_side + by) * t_side);
+        mask[bit >> 6] |= xbits << (bit & 63);
+      }
+    }
+  }
+}
+
+void TileInserter::create_blocks(const BlockAt& block_at, TileInsertResult& result) {
+  const std::int32_t t_side = blocks_per_tile_side_;
+  const std::int32_t per_tile = tile_shift_ - block_shift_;
+  block_offsets_.assign(tiles_.size() + 1, 0);
+  tile_blocks_.clear();
+  for (std::size_t t = 0; t < tiles_.size(); ++t) {
+    const std::uint64_t* mask = block_masks_.data() + t * mask_words_;
+    for (std::size_t w = 0; w < mask_words_; ++w) {
+      for (std::uint64_t bits = mask[w]; bits != 0; bits &= bits - 1) {
+        const auto local = static_cast<std::int32_t>(w * 64) + std::countr_zero(bits);
+        const BlockIndex index{(tiles_[t].x << per_tile) + local % t_side,
+                               (tiles_[t].y << per_tile) + (local / t_side) % t_side,
+                               (tiles_[t].z << per_tile) + local / (t_side * t_side)};
+        tile_blocks_.push_back({static_cast<std::uint32_t>(local), &block_at(index)});
+        result.updated_blocks.push_back(index);
+      }
+    }
+    block_offsets_[t + 1] = static_cast<std::uint32_t>(tile_blocks_.size());
+  }
+}
+
+void TileInserter::scatter_point(const TileTarget& target, const std::array<std::int32_t, 3>& base,
+                                 std::size_t i, const TrainingSet& training,
+                                 const KernelTable& kernel) const {
+  const std::int32_t side = 1 << tile_shift_;
+  const auto k = static_cast<std::size_t>(params_.num_classes);
+  const CellBox& support = boxes_[i];
+  CellBox box{};
+  for (int a = 0; a < 3; ++a) {
+    box.lo[a] = std::max(support.lo[a], base[a]) - base[a];
+    box.hi[a] = std::min(support.hi[a], base[a] + side - 1) - base[a];
+  }
+  if (params_.method == Method::kCsm) {
+    const std::size_t row = static_cast<std::size_t>(box.lo[2] * side + box.lo[1]);
+    float* alpha = target.evidence + (row * side + box.lo[0]) * k;
+    if (training.labels[i] >= 0) {
+      alpha[training.labels[i]] += 1.0f;
+    } else {
+      const float* y = training.probabilities.data() + i * k;
+      for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
+    }
+    target.mark(row, std::uint32_t{1} << box.lo[0], side);
+    return;
+  }
+  const float* first = distances_.data() + i * 3 * width_;
+  std::array<const float*, 3> d2{};
+  for (int a = 0; a < 3; ++a) d2[a] = first + a * width_ + (base[a] + box.lo[a] - support.lo[a]);
+  if (training.labels[i] >= 0) {
+    smooth_point<false>(target, side, box, d2, training, i, kernel);
+  } else {
+    smooth_point<true>(target, side, box, d2, training, i, kernel);
+  }
+}
+
+void TileInserter::write_back(Scratch& scratch, std::size_t tile) const {
+  const std::int32_t side = 1 << tile_shift_;
+  const std::int32_t n = 1 << block_shift_;
+  const std::int32_t t_side = blocks_per_tile_side_;
+  const auto k = static_cast<std::size_t>(params_.num_classes);
+  const std::size_t row_floats = static_cast<std::size_t>(n) * k;
+  const std::uint64_t low = (std::uint64_t{1} << n) - 1;
+  for (std::uint32_t j = block_offsets_[tile]; j < block_offsets_[tile + 1]; ++j) {
+    const auto local = static_cast<std::int32_t>(tile_blocks_[j].local);
+    Block& block = *tile_blocks_[j].block;
+    const std::int32_t x0 = (local % t_side) * n;
+    const std::int32_t y0 = ((local / t_side) % t_side) * n;
+    const std::int32_t z0 = (local / (t_side * t_side)) * n;
+    for (std::int32_t z = 0; z < n; ++z) {
+      for (std::int32_t y = 0; y < n; ++y) {
+        const auto row = static_cast<std::size_t>((z0 + z) * side + y0 + y);
+        const std::uint64_t bits = (std::uint64_t{scratch.rows[row]} >> x0) & low;
+        if (bits == 0) continue;
+        // Only cells with a bit are non-zero, so adding and clearing the whole block row
+        // is exact and leaves the scratch zeroed.
+        float* src = scratch.evidence.data() + (row * side + x0) * k;
+        const int cell = block.cell_of(0, y, z);
+        float* dst = block.cell_evidence_mutable(cell);
+        for (std::size_t f = 0; f < row_floats; ++f) dst[f] += src[f];
+        std::memset(src, 0, row_floats * sizeof(float));
+        block.mark_observed_word(cell >> 6, bits << (cell & 63));
+      }
+    }
+  }
+  std::fill(scratch.rows.begin(), scratch.rows.end(), 0u);
+}
+
+void TileInserter::process_tile(std::size_t tile, const TrainingSet& training,
+                                const KernelTable& kernel) {
+  const std::int32_t side = 1 << tile_shift_;
+  const std::array<std::int32_t, 3> base{
+      tiles_[tile].x << tile_shift_, tiles_[tile].y << tile_shift_, tiles_[tile].z << tile_shift_};
+  if (tile_shift_ == block_shift_) {
+    // The tile is one block: write into it directly, in the same order as the scratch would.
+    Block* block = tile_blocks_[block_offsets_[tile]].block;
+    const TileTarget target{block->cell_evidence_mutable(0), nullptr, block};
+    for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
+      scatter_point(target, base, tile_points_[p], training, kernel);
+    }
+    return;
+  }
+  Scratch& scratch = scratch_.local();
+  if (scratch.rows.empty()) {
+    const auto cells = static_cast<std::size_t>(side) * side * side;
+    scratch.evidence.assign(cells * static_cast<std::size_t>(params_.num_classes), 0.0f);
+    scratch.rows.assign(static_cast<std::size_t>(side) * side, 0u);
+  }
+  const TileTarget target{scratch.evidence.data(), scratch.rows.data(), nullptr};
+  for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
+    scatter_point(target, base, tile_points_[p], training, kernel);
+  }
+  write_back(scratch, tile);
+}
+
+TileInsertResult TileInserter::insert(const TrainingSet& training, const KernelTable& kernel,
+                                      const BlockAt& block_at) {
+  TileInsertResult result;
+  prepare_points(training);
+  result.rejected_points = static_cast<std::size_t>(std::count(bad_.begin(), bad_.end(), 1));
+  group_by_tile(training.size());
+  // Creating blocks mutates the map's table, so it happens before the parallel part.
+  create_blocks(block_at, result);
+  // Scratch tiles are big, uneven units of work: the busiest go first so that the last ones
+  // to finish are small (the order cannot change results, tiles are independent). Blocks
+  // written in place are small (S-CSM: a few points each) and go in groups of
+  // kBlocksPerTask to keep the task overhead down.
+  const bool in_place = tile_shift_ == block_shift_;
+  order_.resize(tiles_.size());
+  std::iota(order_.begin(), order_.end(), std::uint32_t{0});
+  if (!in_place) {
+    std::stable_sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return tile_offsets_[a + 1] - tile_offsets_[a] > tile_offsets_[b + 1] - tile_offsets_[b];
+    });
+  }
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, tiles_.size(), in_place ? kBlocksPerTask : 1),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+          process_tile(order_[t], training, kernel);
+        }
+      },
+      tbb::simple_partitioner());
+  return result;
+}
+
+}  // namespace semap::mapping::detail
