@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <memory>
 #include <random>
@@ -54,6 +55,13 @@ double cpu_seconds() {
     return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
   };
   return secs(u.ru_utime) + secs(u.ru_stime);
+}
+
+// CPU seconds used so far by the calling thread.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 struct Pipe {
@@ -168,6 +176,12 @@ struct Throughput {
   double reader_cpu_us = 0;  // reader process CPU time per received block
   std::uint64_t received = 0;
   std::uint64_t bad = 0;
+  std::uint64_t write_timeouts = 0;  // writes that waited max_blocking_time for the reader
+  double writer_thread_busy = 0;     // writing thread's CPU time / wall time: < 1 = waiting
+  // Context switches of the writing thread: voluntary ones block in dds_write (flow control,
+  // locks), involuntary ones are preemption by other processes.
+  std::int64_t writer_voluntary_switches = 0;
+  std::int64_t writer_involuntary_switches = 0;
 };
 
 Throughput throughput(int domain, std::uint16_t cells, double seconds) {
@@ -188,6 +202,9 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
     blocks.push_back(block({i % 10, i / 10 % 10, i / 100}, cells, 1));
   std::uint64_t written = 0;
   const double cpu0 = cpu_seconds();
+  const double thread0 = thread_cpu_seconds();
+  rusage switches0{};
+  getrusage(RUSAGE_THREAD, &switches0);
   const auto start = Clock::now();
   std::uint32_t version = 1;
   while (Clock::now() - start < std::chrono::duration<double>(seconds)) {
@@ -200,6 +217,9 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
   }
   const double wsecs = std::chrono::duration<double>(Clock::now() - start).count();
   const double wcpu = cpu_seconds() - cpu0;
+  const double thread_cpu = thread_cpu_seconds() - thread0;
+  rusage switches1{};
+  getrusage(RUSAGE_THREAD, &switches1);
   std::istringstream r(reader.expect("result").substr(7));
   std::uint64_t n = 0, bytes = 0, bad = 0;
   double secs = 0, rcpu = 0;
@@ -210,6 +230,10 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
   t.blocks_per_s = secs > 0 ? static_cast<double>(n) / secs : 0;
   t.mb_per_s = secs > 0 ? static_cast<double>(bytes) / secs / 1e6 : 0;
   t.written_per_s = static_cast<double>(written) / wsecs;
+  t.write_timeouts = pub.counters().write_timeouts;
+  t.writer_thread_busy = thread_cpu / wsecs;
+  t.writer_voluntary_switches = switches1.ru_nvcsw - switches0.ru_nvcsw;
+  t.writer_involuntary_switches = switches1.ru_nivcsw - switches0.ru_nivcsw;
   t.writer_cpu_us = written > 0 ? 1e6 * wcpu / static_cast<double>(written) : 0;
   t.reader_cpu_us = n > 0 ? 1e6 * rcpu / static_cast<double>(n) : 0;
   return t;
@@ -292,8 +316,14 @@ int main(int argc, char** argv) {
       std::printf("%u^3 cells: written %.0f/s received %.0f/s (%llu blocks, %llu invalid)\n", cells,
                   t.written_per_s, t.blocks_per_s, static_cast<unsigned long long>(t.received),
                   static_cast<unsigned long long>(t.bad));
-      std::printf("CPU per block: writer %.1f us, reader %.1f us\n", t.writer_cpu_us,
-                  t.reader_cpu_us);
+      std::printf(
+          "CPU per block: writer %.1f us, reader %.1f us; writing thread busy %.0f %% of the"
+          " time; write timeouts %llu\n",
+          t.writer_cpu_us, t.reader_cpu_us, 100.0 * t.writer_thread_busy,
+          static_cast<unsigned long long>(t.write_timeouts));
+      std::printf("writing thread context switches: %lld voluntary, %lld involuntary\n",
+                  static_cast<long long>(t.writer_voluntary_switches),
+                  static_cast<long long>(t.writer_involuntary_switches));
       return 0;
     }
     const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
