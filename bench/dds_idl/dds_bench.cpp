@@ -2,19 +2,24 @@
 // Prints blocks/s and MB/s at two block sizes, publish-to-receive latency p50/p99 at 10 Hz map
 // updates, and ddsperf's rate for the same payload sizes in the same run.
 //   dds_bench [seconds [repetitions]]   (default 3 s a throughput run, median of 3)
+//   dds_bench --throughput CELLS SECONDS  (one throughput run of ours only: for profiling)
 // The reader is this binary again (`dds_bench --reader ...`). CYCLONEDDS_URI defaults to the
 // loopback XML of the source tree, so nothing leaves 127.0.0.1.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <memory>
 #include <random>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "semap/dds_idl/block_codec.hpp"
@@ -40,6 +45,23 @@ std::size_t block_bytes(std::uint16_t cells) {
   s = (s + 3) / 4 * 4 + 4 + 2 * n;      // argmax_class (aligned length)
   s = (s + 3) / 4 * 4 + 4 + 4 * n + 4;  // variance, empty evidence
   return s;
+}
+
+// CPU seconds used so far by this process, all threads (DDS's own threads included).
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  const auto secs = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
+  return secs(u.ru_utime) + secs(u.ru_stime);
+}
+
+// CPU seconds used so far by the calling thread.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 struct Pipe {
@@ -73,18 +95,24 @@ int run_reader(int domain, const std::string& ns, bool latency) {
   sd::Reader<sd::msg::SemanticMapBlock> reader(p, topic, sd::topic_qos(sd::SemapTopic::kMapBlocks));
   while (reader.matched() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   std::cout << "ready" << std::endl;
+  const double cpu0 = cpu_seconds();
   std::uint64_t n = 0, bad = 0, bytes = 0;
   Clock::time_point first, last;
   std::vector<double> latencies_us;
   const sd::BlockLimits limits;
+  std::unordered_map<sd::BlockIndex, sd::BlockSnapshot, sd::BlockIndexHash> map;
   for (;;) {
     const bool got = reader.wait(std::chrono::milliseconds(n == 0 ? 20000 : 1500));
     if (!got) break;
     reader.take_each([&](const sd::msg::SemanticMapBlock& m, const dds_sample_info_t&) {
       const Stamp now = Stamp::now();
-      // Validation and copy as the MapClient does them, so the figure is our stack's.
-      const sd::DecodedBlock d = sd::decode_block(m, limits);
-      if (!d.block) ++bad;
+      // Validation and copy into the block's map entry as the MapClient does them, so the
+      // figure is our stack's.
+      if (sd::check_block(m, limits).ok()) {
+        sd::copy_block(m, map[sd::BlockIndex{m.ix_, m.iy_, m.iz_}]);
+      } else {
+        ++bad;
+      }
       if (n == 0) first = Clock::now();
       last = Clock::now();
       ++n;
@@ -96,7 +124,9 @@ int run_reader(int domain, const std::string& ns, bool latency) {
     });
   }
   const double secs = std::chrono::duration<double>(last - first).count();
-  std::cout << "result " << n << " " << bytes << " " << secs << " " << bad;
+  // The reader's CPU time includes the final idle wait, which costs next to nothing.
+  std::cout << "result " << n << " " << bytes << " " << secs << " " << bad << " "
+            << cpu_seconds() - cpu0;
   if (latency && !latencies_us.empty()) {
     std::sort(latencies_us.begin(), latencies_us.end());
     const auto pct = [&](double q) {
@@ -142,8 +172,16 @@ struct Throughput {
   double blocks_per_s = 0;
   double mb_per_s = 0;
   double written_per_s = 0;
+  double writer_cpu_us = 0;  // writer process CPU time per written block
+  double reader_cpu_us = 0;  // reader process CPU time per received block
   std::uint64_t received = 0;
   std::uint64_t bad = 0;
+  std::uint64_t write_timeouts = 0;  // writes that waited max_blocking_time for the reader
+  double writer_thread_busy = 0;     // writing thread's CPU time / wall time: < 1 = waiting
+  // Context switches of the writing thread: voluntary ones block in dds_write (flow control,
+  // locks), involuntary ones are preemption by other processes.
+  std::int64_t writer_voluntary_switches = 0;
+  std::int64_t writer_involuntary_switches = 0;
 };
 
 Throughput throughput(int domain, std::uint16_t cells, double seconds) {
@@ -163,6 +201,10 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
   for (int i = 0; i < kBlocks; ++i)
     blocks.push_back(block({i % 10, i / 10 % 10, i / 100}, cells, 1));
   std::uint64_t written = 0;
+  const double cpu0 = cpu_seconds();
+  const double thread0 = thread_cpu_seconds();
+  rusage switches0{};
+  getrusage(RUSAGE_THREAD, &switches0);
   const auto start = Clock::now();
   std::uint32_t version = 1;
   while (Clock::now() - start < std::chrono::duration<double>(seconds)) {
@@ -174,16 +216,26 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
     written += pub.publish_changed(Stamp::now());
   }
   const double wsecs = std::chrono::duration<double>(Clock::now() - start).count();
+  const double wcpu = cpu_seconds() - cpu0;
+  const double thread_cpu = thread_cpu_seconds() - thread0;
+  rusage switches1{};
+  getrusage(RUSAGE_THREAD, &switches1);
   std::istringstream r(reader.expect("result").substr(7));
   std::uint64_t n = 0, bytes = 0, bad = 0;
-  double secs = 0;
-  r >> n >> bytes >> secs >> bad;
+  double secs = 0, rcpu = 0;
+  r >> n >> bytes >> secs >> bad >> rcpu;
   Throughput t;
   t.received = n;
   t.bad = bad;
   t.blocks_per_s = secs > 0 ? static_cast<double>(n) / secs : 0;
   t.mb_per_s = secs > 0 ? static_cast<double>(bytes) / secs / 1e6 : 0;
   t.written_per_s = static_cast<double>(written) / wsecs;
+  t.write_timeouts = pub.counters().write_timeouts;
+  t.writer_thread_busy = thread_cpu / wsecs;
+  t.writer_voluntary_switches = switches1.ru_nvcsw - switches0.ru_nvcsw;
+  t.writer_involuntary_switches = switches1.ru_nivcsw - switches0.ru_nivcsw;
+  t.writer_cpu_us = written > 0 ? 1e6 * wcpu / static_cast<double>(written) : 0;
+  t.reader_cpu_us = n > 0 ? 1e6 * rcpu / static_cast<double>(n) : 0;
   return t;
 }
 
@@ -218,7 +270,8 @@ Latency latency(int domain, std::uint16_t cells, int blocks_per_update, double s
   Latency l;
   std::uint64_t bytes = 0, bad = 0;
   double secs = 0;
-  r >> l.samples >> bytes >> secs >> bad >> l.p50_us >> l.p99_us >> l.max_us;
+  double cpu = 0;
+  r >> l.samples >> bytes >> secs >> bad >> cpu >> l.p50_us >> l.p99_us >> l.max_us;
   return l;
 }
 
@@ -255,10 +308,26 @@ int main(int argc, char** argv) {
     if (argc == 5 && std::strcmp(argv[1], "--reader") == 0) {
       return run_reader(std::atoi(argv[2]), argv[3], std::strcmp(argv[4], "1") == 0);
     }
-    const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
-    const int reps = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
     std::random_device rd;
     const int domain = 1 + static_cast<int>(rd() % 200);
+    if (argc == 4 && std::strcmp(argv[1], "--throughput") == 0) {
+      const auto cells = static_cast<std::uint16_t>(std::atoi(argv[2]));
+      const Throughput t = throughput(domain, cells, std::atof(argv[3]));
+      std::printf("%u^3 cells: written %.0f/s received %.0f/s (%llu blocks, %llu invalid)\n", cells,
+                  t.written_per_s, t.blocks_per_s, static_cast<unsigned long long>(t.received),
+                  static_cast<unsigned long long>(t.bad));
+      std::printf(
+          "CPU per block: writer %.1f us, reader %.1f us; writing thread busy %.0f %% of the"
+          " time; write timeouts %llu\n",
+          t.writer_cpu_us, t.reader_cpu_us, 100.0 * t.writer_thread_busy,
+          static_cast<unsigned long long>(t.write_timeouts));
+      std::printf("writing thread context switches: %lld voluntary, %lld involuntary\n",
+                  static_cast<long long>(t.writer_voluntary_switches),
+                  static_cast<long long>(t.writer_involuntary_switches));
+      return 0;
+    }
+    const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
+    const int reps = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
     std::printf("dds_bench: domain %d, CYCLONEDDS_URI=%s, %.0f s a run, median of %d\n", domain,
                 std::getenv("CYCLONEDDS_URI"), seconds, reps);
     // ddsperf twice: its default (reliable keep-all, one key: the baseline) and with
@@ -272,13 +341,15 @@ int main(int argc, char** argv) {
     };
     for (std::uint16_t cells : {5, 8}) {
       const std::size_t bytes = block_bytes(cells);
-      std::vector<double> ours, mbs, written, ref, ref_k1;
+      std::vector<double> ours, mbs, written, wcpu, rcpu, ref, ref_k1;
       std::uint64_t bad = 0;
       for (int rep = 0; rep < reps; ++rep) {
         const Throughput t = throughput(domain, cells, seconds);
         ours.push_back(t.blocks_per_s);
         mbs.push_back(t.mb_per_s);
         written.push_back(t.written_per_s);
+        wcpu.push_back(t.writer_cpu_us);
+        rcpu.push_back(t.reader_cpu_us);
         bad += t.bad;
         ref.push_back(ddsperf_rate(domain, bytes, seconds, ""));
         ref_k1.push_back(ddsperf_rate(domain, bytes, seconds, " -k 1 -n 1000"));
@@ -289,6 +360,8 @@ int main(int argc, char** argv) {
       std::printf("%-22s %10.0f %8.1f %10.0f %14.0f %5.0f%% %16.0f %5.0f%%%s\n", label, o,
                   median(mbs), median(written), r, r > 0 ? 100.0 * o / r : 0.0, r1,
                   r1 > 0 ? 100.0 * o / r1 : 0.0, bad ? " (INVALID BLOCKS RECEIVED)" : "");
+      std::printf("  CPU per block (all threads): writer %.1f us, reader %.1f us\n", median(wcpu),
+                  median(rcpu));
       std::fflush(stdout);
     }
     for (int per_update : {10, 100}) {

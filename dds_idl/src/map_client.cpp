@@ -66,27 +66,28 @@ void MapClient::on_info(const msg::MapInfo& m) {
 }
 
 void MapClient::on_block(const msg::SemanticMapBlock& m) {
-  DecodedBlock d = decode_block(m, config_.limits);
-  if (!d.block) {
-    ++counters_.rejected[static_cast<std::size_t>(d.reason)];
-    last_error_ = std::move(d.error);
+  BlockCheck c = check_block(m, config_.limits);
+  if (!c.ok()) {
+    ++counters_.rejected[static_cast<std::size_t>(c.reason)];
+    last_error_ = std::move(c.error);
     common::logger("dds.map_client")->warn("rejected {}", last_error_);
     return;
   }
-  BlockSnapshot& b = *d.block;
   BlockLimits& l = config_.limits;
   // Without MapInfo the first valid block fixes the shape of the map.
-  if (l.num_classes == 0) l.num_classes = b.num_classes;
-  if (l.block_cells == 0) l.block_cells = b.block_cells;
-  if (l.resolution <= 0.0f) l.resolution = b.resolution;
+  if (l.num_classes == 0) l.num_classes = m.num_classes_;
+  if (l.block_cells == 0) l.block_cells = m.block_cells_;
+  if (l.resolution <= 0.0f) l.resolution = m.resolution_;
 
-  auto it = blocks_.find(b.index);
-  if (it != blocks_.end() && it->second.version > b.version) {
+  const BlockIndex index{m.ix_, m.iy_, m.iz_};
+  auto [it, inserted] = blocks_.try_emplace(index);
+  if (!inserted && it->second.version > m.version_) {
     ++counters_.stale;
     return;
   }
-  changed_.push_back(b.index);
-  blocks_.insert_or_assign(b.index, std::move(b));
+  // Into the block's existing storage: a new version of a known block allocates nothing.
+  copy_block(m, it->second);
+  changed_.push_back(index);
   ++counters_.accepted;
 }
 

@@ -99,6 +99,51 @@ TEST(BlockCodec, RejectsEachKindOfBadBlockWithItsReason) {
   EXPECT_EQ(decode_spoiled(sample_block(false), other_resolution).reason, BlockReject::kShape);
 }
 
+// The whole-array checks must find a bad value wherever it sits (vector body or scalar tail)
+// and still name the first one; -0.0 is a valid variance, as it was for the per-cell checks.
+TEST(BlockCodec, WholeArrayChecksFindEveryBadCellAndNameTheFirst) {
+  const BlockSnapshot good = BlockSnapshot::empty({1, 2, 3}, 0.1f, 5, 4, true);
+  const std::size_t cells = good.cell_count();
+  for (std::size_t i : {std::size_t{0}, std::size_t{17}, cells - 1}) {
+    auto state = good;
+    state.state[i] = static_cast<CellState>(200);
+    auto cls = good;
+    cls.argmax_class[i] = 4;
+    auto variance = good;
+    variance.variance[i] = std::numeric_limits<float>::infinity();
+    auto evidence = good;
+    evidence.evidence[evidence.evidence.size() - 1 - i] = -0.5f;
+    const std::string at = "[" + std::to_string(i) + "]";
+    EXPECT_NE(decode_spoiled(state).error.find("state" + at), std::string::npos);
+    EXPECT_NE(decode_spoiled(cls).error.find("argmax_class" + at), std::string::npos);
+    EXPECT_NE(decode_spoiled(variance).error.find("variance" + at), std::string::npos);
+    EXPECT_EQ(decode_spoiled(evidence).reason, BlockReject::kOutOfRange);
+  }
+  auto two_bad = good;
+  two_bad.variance[40] = std::numeric_limits<float>::quiet_NaN();
+  two_bad.variance[3] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(decode_spoiled(two_bad).error.find("variance[3]"), std::string::npos);
+  auto negative_zero = good;
+  negative_zero.variance[5] = -0.0f;
+  EXPECT_TRUE(decode_spoiled(negative_zero).block);
+}
+
+TEST(BlockCodec, CopyIntoAnExistingBlockReplacesEveryField) {
+  const BlockSnapshot newer = sample_block(false);
+  BlockSnapshot held = BlockSnapshot::empty({7, 7, 7}, 0.5f, 4, 3, true);
+  held.version = 2;
+  const BlockMessage m(newer, common::Stamp(1), "map");
+  ASSERT_TRUE(check_block(m.get(), {}).ok());
+  copy_block(m.get(), held);
+  EXPECT_EQ(held.index, newer.index);
+  EXPECT_EQ(held.resolution, newer.resolution);
+  EXPECT_EQ(held.version, newer.version);
+  EXPECT_EQ(held.state, newer.state);
+  EXPECT_EQ(held.argmax_class, newer.argmax_class);
+  EXPECT_EQ(held.variance, newer.variance);
+  EXPECT_TRUE(held.evidence.empty());
+}
+
 TEST(BlockGeometry, PointsMapToTheCellWhoseCentreTheyAreNear) {
   const BlockSnapshot b = BlockSnapshot::empty({-2, 0, 5}, 0.2f, 4, 2, false);
   for (std::size_t i = 0; i < b.cell_count(); ++i) {

@@ -45,13 +45,28 @@ enum class BlockReject : std::uint8_t {
 
 const char* to_string(BlockReject reason);
 
+// The verdict on a received message: reason kNone, or the reason and an error naming the block
+// index and the offending field.
+struct BlockCheck {
+  BlockReject reason = BlockReject::kNone;
+  std::string error;
+  bool ok() const { return reason == BlockReject::kNone; }
+};
+
 struct DecodedBlock {
   std::optional<BlockSnapshot> block;
   BlockReject reason = BlockReject::kNone;
   std::string error;  // names the block index and the offending field
 };
 
-// Validates a received message and copies it into a BlockSnapshot. Never throws on bad data.
+// Validates a received message without copying it. Never throws on bad data.
+BlockCheck check_block(const msg::SemanticMapBlock& m, const BlockLimits& limits);
+
+// Copies a message that passed check_block into `out`, reusing out's storage (no allocation
+// when `out` already holds a block of the same shape, as a map's entry for that index does).
+void copy_block(const msg::SemanticMapBlock& m, BlockSnapshot& out);
+
+// check_block, then copy_block into a new BlockSnapshot.
 DecodedBlock decode_block(const msg::SemanticMapBlock& m, const BlockLimits& limits);
 
 }  // namespace semap::dds_idl

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <chrono>
+#include <memory>
 
 #include "semap/dds_idl/topic.hpp"
 
@@ -22,28 +23,25 @@ class Reader {
   }
 
   // Takes every available sample and calls f(const T&, const dds_sample_info_t&) for those
-  // carrying data (not for dispose/unregister notifications). Returns how many had data.
+  // carrying data (not for dispose/unregister notifications). Returns how many had data. The
+  // sample is valid only during the call: it lives in storage this reader reuses.
   template <typename F>
   std::size_t take_each(F&& f) {
     std::size_t count = 0;
     for (;;) {
-      std::array<void*, kBatch> samples{};
+      // Non-null buffers make Cyclone deserialise into the samples of the previous take,
+      // reusing their sequence and string buffers, where a loan allocates and frees every
+      // sequence of every sample (a quarter of the instructions to receive a map block).
+      std::array<void*, kBatch> samples;
+      for (std::size_t i = 0; i < kBatch; ++i) samples[i] = &(*storage_)[i];
       std::array<dds_sample_info_t, kBatch> infos{};
       const dds_return_t n =
           dds_take(entity_.handle(), samples.data(), infos.data(), kBatch, kBatch);
       if (n < 0) throw DdsError("dds_take " + topic_name_, n);
       if (n == 0) break;
-      // The loan goes back even when f throws.
-      struct Loan {
-        dds_entity_t reader;
-        void** buf;
-        dds_return_t n;
-        ~Loan() { dds_return_loan(reader, buf, n); }
-      } loan{entity_.handle(), samples.data(), n};
       for (dds_return_t i = 0; i < n; ++i) {
         if (!infos[static_cast<std::size_t>(i)].valid_data) continue;
-        f(*static_cast<const T*>(samples[static_cast<std::size_t>(i)]),
-          infos[static_cast<std::size_t>(i)]);
+        f((*storage_)[static_cast<std::size_t>(i)], infos[static_cast<std::size_t>(i)]);
         ++count;
       }
       if (static_cast<std::size_t>(n) < kBatch) break;
@@ -69,10 +67,21 @@ class Reader {
 
  private:
   static constexpr std::size_t kBatch = 64;
+  using Samples = std::array<T, kBatch>;
+  // Frees what Cyclone allocated inside the samples; holds at most kBatch samples' worth of
+  // buffers, each as large as the largest sample taken into that slot.
+  struct FreeSamples {
+    void operator()(Samples* s) const {
+      for (T& sample : *s) dds_sample_free(&sample, TypeDescriptor<T>::get(), DDS_FREE_CONTENTS);
+      delete s;
+    }
+  };
+
   std::string topic_name_;
   Entity entity_;
   Entity condition_;
   Entity waitset_;
+  std::unique_ptr<Samples, FreeSamples> storage_{new Samples{}};
 };
 
 }  // namespace semap::dds_idl
