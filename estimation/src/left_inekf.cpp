@@ -200,32 +200,27 @@ CorrectionResult LeftInekf::correct_position(const Vector3d& position, const Mat
   // Y = X b with b = (lever, 0, 1). In world form the residual y - (p + R lever) is
   // rho_p - [p + R lever]x phi to first order (the left innovation R^T (y - p) - lever rotated
   // to the world), with noise N itself.
-  CorrectionResult out;
   const Vector3d antenna = p_pos_ + r_ * lever_arm;
-  out.residual = position - antenna;
   Matrix3x15 h = Matrix3x15::Zero();
   h.block<3, 3>(0, kRot) = -skew(antenna - origin_);
   h.block<3, 3>(0, kPos).setIdentity();
-  Matrix15 p = world_covariance();
-  const KalmanUpdate u = joseph_update(p, out.residual, h, covariance, gate2);
-  out.accepted = u.accepted;
-  out.mahalanobis2 = u.mahalanobis2;
-  if (u.accepted) {
-    set_world_covariance(p);
-    correct_world(u.delta);
-  }
-  return out;
+  return update_world(position - antenna, h, covariance, gate2);
 }
 
 CorrectionResult LeftInekf::correct_velocity(const Vector3d& velocity, const Matrix3d& covariance,
                                              double gate2) {
-  CorrectionResult out;
-  out.residual = velocity - v_;
   Matrix3x15 h = Matrix3x15::Zero();
   h.block<3, 3>(0, kRot) = -skew(v_);
   h.block<3, 3>(0, kVel).setIdentity();
+  return update_world(velocity - v_, h, covariance, gate2);
+}
+
+CorrectionResult LeftInekf::update_world(const Vector3d& residual, const Matrix3x15& h,
+                                         const Matrix3d& noise, double gate2) {
+  CorrectionResult out;
+  out.residual = residual;
   Matrix15 p = world_covariance();
-  const KalmanUpdate u = joseph_update(p, out.residual, h, covariance, gate2);
+  const KalmanUpdate u = joseph_update(p, residual, h, noise, gate2);
   out.accepted = u.accepted;
   out.mahalanobis2 = u.mahalanobis2;
   if (u.accepted) {

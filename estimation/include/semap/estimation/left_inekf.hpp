@@ -4,6 +4,7 @@
 
 #include "semap/estimation/filter_params.hpp"
 #include "semap/estimation/inekf_imu_step.hpp"
+#include "semap/estimation/kalman_update.hpp"
 #include "semap/estimation/nav_filter.hpp"
 
 namespace semap::estimation {
@@ -51,6 +52,10 @@ class LeftInekf final : public NavFilter {
  private:
   void add_process_noise(double dt);
   void apply_step(const InekfImuStep& step);
+  // Gated Joseph update of the world-form covariance with a world-form residual and H; on
+  // acceptance corrects the state.
+  CorrectionResult update_world(const Eigen::Vector3d& residual, const Matrix3x15& h,
+                                const Eigen::Matrix3d& noise, double gate2);
   // X+ = exp(delta) X for a world-form correction delta (= X exp(Ad_X^-1 delta)).
   void correct_world(const Vector15& delta);
   // Moves the origin to the current position, re-expressing the covariance through
