@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cmath>
 
 #include "semap/estimation/so3.hpp"
 
@@ -122,30 +123,51 @@ Matrix15 left_from_world(const NavState& s) {
   return t;
 }
 
+Matrix9 gravity_shear(const Vector3d& gravity, double t) {
+  Matrix9 f = Matrix9::Identity();
+  const Matrix3d gx = skew(gravity);
+  f.block<3, 3>(kVel, kRot) = gx * t;
+  f.block<3, 3>(kPos, kRot) = gx * (0.5 * t * t);
+  f.block<3, 3>(kPos, kVel) = Matrix3d::Identity() * t;
+  return f;
+}
+
 InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const Vector3d& p,
                                    const Vector3d& w, const Vector3d& a, double dt,
-                                   const Vector3d& gravity) {
+                                   const Vector3d& gravity, double t0) {
   InekfImuStep step;
   step.dt = dt;
+  step.t0 = t0;
+  const double t1 = t0 + dt;
+  step.c = v - t0 * gravity;
+  step.e = p - t0 * v + (0.5 * t0 * t0) * gravity;
   const Vector3d phi = w * dt;
-  const double theta = phi.norm();
-  const auto c = gamma_coefficients(theta);
-  const Matrix3d k = skew(phi);
-  // K^2 = phi phi^T - |phi|^2 I.
-  Matrix3d k2 = phi * phi.transpose();
-  k2.diagonal().array() -= phi.squaredNorm();
-  step.rotation_increment = Matrix3d::Identity() + c.a0 * k + c.b0 * k2;
-  const Matrix3d g1 = Matrix3d::Identity() + c.a1 * k + c.b1 * k2;
-  const Matrix3d g2 = 0.5 * Matrix3d::Identity() + c.a2 * k + c.b2 * k2;
-  step.u1.noalias() = g1 * (a * dt);
-  step.u2.noalias() = g2 * (a * (dt * dt));
+  const double theta2 = phi.squaredNorm();
+  const double theta = std::sqrt(theta2);
+  const auto co = gamma_coefficients(theta);
+  // R Gamma_k = g0 R + g1 R K + g2 R K^2 with K = [phi]x, R K = [R phi]x R and
+  // R K^2 = (R phi) phi^T - |phi|^2 R: three rotation integrals for the price of one product.
+  const Vector3d psi = r * phi;
+  Matrix3d rk;
+  for (int j = 0; j < 3; ++j) rk.col(j) = psi.cross(r.col(j));
+  Matrix3d rk2 = psi * phi.transpose();
+  rk2 -= theta2 * r;
+  step.rotation = r + co.a0 * rk + co.b0 * rk2;
+  const Matrix3d a1 = dt * (r + co.a1 * rk + co.b1 * rk2);                // R Gamma1 dt
+  const Matrix3d a2 = (dt * dt) * (0.5 * r + co.a2 * rk + co.b2 * rk2);  // R Gamma2 dt^2
+  step.dv.noalias() = a1 * a;
+  step.dp.noalias() = a2 * a;
 
-  // G = int_0^dt F(dt - s) Ad_X(s) B ds with B = -[I 0; 0 I; 0 0]: every block is a rotation
-  // integral of R(s) = R e^{W s} (int R(s) ds = R Gamma1 dt, int (dt - s) R(s) ds = R Gamma2 dt^2)
-  // plus the translation terms carried by the series integrals J1, J2.
-  const Matrix3d a1 = r * (g1 * dt);
-  const Matrix3d a2 = r * (g2 * (dt * dt));
-  const double t = -phi.squaredNorm();
+  // G = int_0^dt F(dt - s) Ad_X(s) B ds with B = -[I 0; 0 I; 0 0]; referred to the window
+  // start, F(-t1) G = -int F(-t0 - s) Ad_X(s) ds B. In world form (as for the filter without
+  // windows, t0 = 0) the blocks are G_Rg = G_va = -A1, G_pa = -A2 with A1 = R Gamma1 dt,
+  // A2 = R Gamma2 dt^2, G_vg = -[v + g dt]x A1 - R J1, G_pg = -[p + v dt + g dt^2/2]x A1 - R J2;
+  // the shear F(-t1) turns v + g dt into c, p + v dt + g dt^2/2 into e, adds t1 R J1 to the
+  // position row and t1 A1 to G_pa. With c_b = R^T c, e_b = R^T e ([x]x R = R [R^T x]x):
+  //   vel: -R ([c_b]x Gamma1 dt + J1),  pos: -R ([e_b]x Gamma1 dt + J2 - t1 J1),
+  // where [x]x Gamma1 dt is the collapsed matrix of dt (1, a1, b1)_tau x, so each row block is
+  // one collapsed matrix and one rotation.
+  const double t = -theta2;
   const int degree = series_power(theta);
   SeriesCoefficients s = kSeries[degree];
   for (int m = degree - 1; m >= 0; --m) s = s * t + kSeries[m];
@@ -156,32 +178,34 @@ InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const V
   // x_tau = sum_kappa S(kappa, tau) b_kappa, i.e. X = basis S with S stored row-major.
   const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s1(s.data());
   const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s2(s.data() + 9);
-  const Matrix3d x1 = basis * s1;
-  const Matrix3d x2 = basis * s2;
-  Eigen::Matrix<double, 3, 6> j;
-  j.leftCols<3>() = (dt * dt) * collapsed_matrix(x1.col(0), x1.col(1), x1.col(2), phi, k);
-  j.rightCols<3>() = (dt * dt * dt) * collapsed_matrix(x2.col(0), x2.col(1), x2.col(2), phi, k);
-  Eigen::Matrix<double, 3, 6> rj;
-  rj.noalias() = r * j;
-  const Vector3d v_end = v + gravity * dt;                        // v + g dt
-  const Vector3d p_end = p + v * dt + (0.5 * dt * dt) * gravity;  // p + v dt + g dt^2/2
-  auto& g = step.bias_coupling;
-  g.setZero();
+  const Matrix3d x1 = (dt * dt) * (basis * s1);        // J1 = C(x1)
+  const Matrix3d x2 = (dt * dt * dt) * (basis * s2);  // J2 = C(x2)
+  const Matrix3d k = skew(phi);
+  const Eigen::RowVector3d gamma1_terms(dt, dt * co.a1, dt * co.b1);
+  const Vector3d c_b = r.transpose() * step.c;
+  const Vector3d e_b = r.transpose() * step.e;
+  const Matrix3d zv = c_b * gamma1_terms + x1;
+  const Matrix3d zp = e_b * gamma1_terms + x2 - t1 * x1;
+  Eigen::Matrix<double, 3, 6> body;
+  body.leftCols<3>() = collapsed_matrix(zv.col(0), zv.col(1), zv.col(2), phi, k);
+  body.rightCols<3>() = collapsed_matrix(zp.col(0), zp.col(1), zp.col(2), phi, k);
+  Eigen::Matrix<double, 3, 6> world;
+  world.noalias() = r * body;
+  auto& g = step.coupling;
+  g.row(9).setZero();
   g.block<3, 3>(kRot, 0) = -a1;
-  g.block<3, 3>(kVel, 0).noalias() = -skew(v_end) * a1 - rj.leftCols<3>();
-  g.block<3, 3>(kPos, 0).noalias() = -skew(p_end) * a1 - rj.rightCols<3>();
+  g.block<3, 3>(kVel, 0) = -world.leftCols<3>();
+  g.block<3, 3>(kPos, 0) = -world.rightCols<3>();
+  g.block<3, 3>(kRot, 3).setZero();
   g.block<3, 3>(kVel, 3) = -a1;
-  g.block<3, 3>(kPos, 3) = -a2;
+  g.block<3, 3>(kPos, 3) = t1 * a1 - a2;
   return step;
 }
 
 Matrix15 InekfImuStep::dense(const Vector3d& gravity) const {
   Matrix15 f = Matrix15::Identity();
-  const Matrix3d gx = skew(gravity);
-  f.block<3, 3>(kVel, kRot) = gx * dt;
-  f.block<3, 3>(kPos, kRot) = gx * (0.5 * dt * dt);
-  f.block<3, 3>(kPos, kVel) = Matrix3d::Identity() * dt;
-  f.topRightCorner<9, 6>() = bias_coupling.topRows<9>();
+  f.topLeftCorner<9, 9>() = gravity_shear(gravity, dt);
+  f.topRightCorner<9, 6>() = gravity_shear(gravity, t0 + dt) * coupling.topRows<9>();
   return f;
 }
 

@@ -48,9 +48,9 @@ NavState some_state() {
 NavState advance(const NavState& s, const InekfImuStep& step, const Vector3d& g) {
   NavState out = s;
   const double dt = step.dt;
-  out.rotation = s.rotation * step.rotation_increment;
-  out.velocity = s.velocity + s.rotation * step.u1 + g * dt;
-  out.position = s.position + s.velocity * dt + s.rotation * step.u2 + 0.5 * dt * dt * g;
+  out.rotation = step.rotation;
+  out.velocity = s.velocity + step.dv + g * dt;
+  out.position = s.position + s.velocity * dt + step.dp + 0.5 * dt * dt * g;
   return out;
 }
 
@@ -72,9 +72,9 @@ TEST(LeftInekf, WorldTransitionMatchesNumericalExpm) {
   for (const auto& c : cases) {
     const InekfImuStep step =
         InekfImuStep::compute(s.rotation, s.velocity, s.position, c.w, c.a, c.dt, params.gravity);
-    EXPECT_TRUE(step.rotation_increment.isApprox(gamma0(c.w * c.dt), 1e-14));
-    EXPECT_TRUE(step.u1.isApprox(gamma1(c.w * c.dt) * c.a * c.dt, 1e-14));
-    EXPECT_TRUE(step.u2.isApprox(gamma2(c.w * c.dt) * c.a * c.dt * c.dt, 1e-14));
+    EXPECT_TRUE(step.rotation.isApprox(s.rotation * gamma0(c.w * c.dt), 1e-14));
+    EXPECT_TRUE(step.dv.isApprox(s.rotation * gamma1(c.w * c.dt) * c.a * c.dt, 1e-14));
+    EXPECT_TRUE(step.dp.isApprox(s.rotation * gamma2(c.w * c.dt) * c.a * c.dt * c.dt, 1e-14));
     // Phi_w = T(X+) expm(A dt) T(X)^-1 with A the left-invariant error dynamics.
     const Matrix15 left = (error_dynamics(c.w, c.a) * c.dt).exp();
     const Matrix15 numeric =

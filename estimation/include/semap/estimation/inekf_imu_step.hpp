@@ -7,6 +7,10 @@
 namespace semap::estimation {
 
 using Matrix9 = Eigen::Matrix<double, 9, 9>;
+// Blocks of the world-form covariance with a zero tenth row, so that every column is whole
+// SIMD packets.
+using PaddedBlock9 = Eigen::Matrix<double, 10, 9>;
+using PaddedBlock6 = Eigen::Matrix<double, 10, 6>;
 
 // Adjoint of X = (R, v, p) in SE_2(3): exp(Ad_X xi) X = X exp(xi).
 Matrix9 se23_adjoint(const Eigen::Matrix3d& r, const Eigen::Vector3d& v, const Eigen::Vector3d& p);
@@ -17,28 +21,37 @@ Matrix9 se23_adjoint(const Eigen::Matrix3d& r, const Eigen::Vector3d& v, const E
 Matrix15 world_from_left(const NavState& state);
 Matrix15 left_from_world(const NavState& state);
 
+// The gravity shear F(t) = [[I, 0, 0], [[g]x t, I, 0], [[g]x t^2 / 2, I t, I]]: the group block
+// of the world-form error transition over any t, whatever the motion; F(s) F(t) = F(s + t).
+Matrix9 gravity_shear(const Eigen::Vector3d& gravity, double t);
+
 // One zero-order-hold IMU step of the Left-InEKF from (R, v, p) with bias-corrected rate w
 // and specific force a over dt:
-//   R+ = R Gamma0(w dt),  v+ = v + R u1 + g dt,  p+ = p + v dt + R u2 + g dt^2 / 2.
-// Its error transition is given for world-aligned errors xi_w = Ad_X xi, the same left-invariant
-// error seen from the world (Phi_w = T(X+) Phi T(X)^-1). There the group block of Phi is the
-// constant gravity shear
-//   F = [[I, 0, 0], [[g]x dt, I, 0], [[g]x dt^2 / 2, I dt, I]],
-// so only the 9x6 coupling G to the bias errors depends on the motion; that is what makes the
-// covariance propagation cheap.
+//   R+ = R Gamma0(w dt),  v+ = v + R Gamma1 a dt + g dt,  p+ = p + v dt + R Gamma2 a dt^2 + g dt^2/2.
+// Its error transition for world-aligned errors xi_w = Ad_X xi (Phi_w = T(X+) Phi T(X)^-1) is
+// [[F(dt), G], [0, I]]: only the 9x6 coupling G to the bias errors depends on the motion.
+//
+// The step is taken at time t0 of a covariance window (see CovarianceWindow) and gives G
+// referred to the window start, F(-t1) G with t1 = t0 + dt: products of such steps then add
+// up instead of shearing each other. In those coordinates gravity drops out: G depends on the
+// state only through the free-fall coordinates c = v - g t0 and e = p - v t0 + g t0^2 / 2,
+// which also carry the process noise of the step to the end of the window.
 struct InekfImuStep {
-  Eigen::Matrix3d rotation_increment;  // Gamma0(w dt)
-  Eigen::Vector3d u1, u2;              // Gamma1(w dt) a dt and Gamma2(w dt) a dt^2
-  // G (rows: rot, vel, pos errors; columns: gyro, accel bias errors), padded with a zero
-  // tenth row so that every column is whole SIMD packets.
-  Eigen::Matrix<double, 10, 6> bias_coupling;
+  Eigen::Matrix3d rotation;  // R+
+  Eigen::Vector3d dv, dp;    // R Gamma1 a dt and R Gamma2 a dt^2 (world, without gravity)
+  Eigen::Vector3d c, e;      // free-fall velocity and position at the start of the step
+  // F(-t1) G (rows: rot, vel, pos errors; columns: gyro, accel bias errors) with a zero tenth
+  // row.
+  PaddedBlock6 coupling;
   double dt = 0.0;
+  double t0 = 0.0;
 
   static InekfImuStep compute(const Eigen::Matrix3d& r, const Eigen::Vector3d& v,
                               const Eigen::Vector3d& p, const Eigen::Vector3d& w,
-                              const Eigen::Vector3d& a, double dt, const Eigen::Vector3d& gravity);
+                              const Eigen::Vector3d& a, double dt, const Eigen::Vector3d& gravity,
+                              double t0 = 0.0);
 
-  // The full 15x15 Phi_w, for tests and diagnostics.
+  // The full 15x15 Phi_w of this step (G = F(t1) coupling), for tests and diagnostics.
   Matrix15 dense(const Eigen::Vector3d& gravity) const;
 };
 

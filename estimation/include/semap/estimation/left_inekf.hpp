@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 
+#include "semap/estimation/covariance_window.hpp"
 #include "semap/estimation/filter_params.hpp"
 #include "semap/estimation/inekf_imu_step.hpp"
 #include "semap/estimation/kalman_update.hpp"
@@ -17,7 +18,12 @@ namespace semap::estimation {
 //
 // The covariance is stored for the world-aligned form of that same error, xi_w = Ad_X xi
 // (X = exp(xi_w) X_hat), where the group part of the transition is a constant gravity shear
-// (see InekfImuStep): propagation then costs a few 9x6 products instead of two 15x15 ones.
+// (see InekfImuStep). Its propagation is deferred exactly (CovarianceWindow): propagate()
+// only accumulates running sums, and the covariance is formed when a correction, a query,
+// an origin move or an inflation needs it, and at the latest every `max_window_steps` steps
+// or 0.2 s, which bounds rounding and gives a long IMU-only run its share of the cost.
+// Queries are const and cache their result without ending the window, so the filter's output
+// does not depend on who reads it when.
 // Positions in Ad_X are taken relative to an origin o kept near the robot (moved to it at
 // every correction and after 100 m without one): with o fixed far away, [p]x terms of size
 // |p|^2 var(rot) would cancel in the left covariance and cost digits.
@@ -26,11 +32,10 @@ namespace semap::estimation {
 // returns the left-invariant covariance.
 class LeftInekf final : public NavFilter {
  public:
-  // Covariance blocks with a zero tenth row, so that every column is whole SIMD packets.
-  using PaddedBlock9 = Eigen::Matrix<double, 10, 9>;
-  using PaddedBlock6 = Eigen::Matrix<double, 10, 6>;
+  static constexpr int kDefaultWindowSteps = 20;
 
-  explicit LeftInekf(const FilterParams& params);
+  // max_window_steps = 1 propagates the covariance at every step.
+  explicit LeftInekf(const FilterParams& params, int max_window_steps = kDefaultWindowSteps);
 
   void reset(const NavState& state, const Matrix15& world_covariance) override;
   void propagate(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, double dt) override;
@@ -50,33 +55,33 @@ class LeftInekf final : public NavFilter {
   Eigen::Matrix3d position_covariance_world() const override;
 
  private:
-  void add_process_noise(double dt);
-  void apply_step(const InekfImuStep& step);
+  // Ends the covariance window: the stored covariance becomes P at the filter time.
+  void settle();
+  // P at the filter time, formed on demand and cached until the next propagate.
+  const WorldCovariance& settled() const;
   // Gated Joseph update of the world-form covariance with a world-form residual and H; on
   // acceptance corrects the state.
   CorrectionResult update_world(const Eigen::Vector3d& residual, const Matrix3x15& h,
                                 const Eigen::Matrix3d& noise, double gate2);
   // X+ = exp(delta) X for a world-form correction delta (= X exp(Ad_X^-1 delta)).
   void correct_world(const Vector15& delta);
-  // Moves the origin to the current position, re-expressing the covariance through
+  // Moves the origin to the current position, re-expressing the (settled) covariance through
   // Ad_E (E = (e, dv, dp): identity when only moving) combined with the translation.
   void move_origin(const Eigen::Matrix3d& e, const Eigen::Vector3d& dv, const Eigen::Vector3d& dp);
   NavState relative_state() const;  // the state with positions relative to origin_
-  Matrix15 world_covariance() const;
-  void set_world_covariance(const Matrix15& p);
 
   FilterParams params_;
-  Eigen::Matrix<double, 15, 1> q_diag_;  // continuous process noise densities squared
+  int max_window_steps_;
   Eigen::Matrix3d r_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d v_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_pos_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // of the covariance's world form
   Eigen::Vector3d bg_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d ba_ = Eigen::Vector3d::Zero();
-  // Covariance of (xi_w, zeta) as [[A, B], [B^T, C]]: A over rot/vel/pos, C over the biases.
-  PaddedBlock9 a_ = PaddedBlock9::Identity();
-  PaddedBlock6 b_ = PaddedBlock6::Zero();
-  Eigen::Matrix<double, 6, 6> c_ = Eigen::Matrix<double, 6, 6>::Identity();
+  WorldCovariance p_;  // at the start of the window
+  CovarianceWindow window_;
+  mutable WorldCovariance cached_;  // p_ propagated over the window, valid if cache_valid_
+  mutable bool cache_valid_ = false;
   unsigned steps_since_normalise_ = 0;
 };
 

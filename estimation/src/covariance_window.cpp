@@ -1,0 +1,166 @@
+#include "semap/estimation/covariance_window.hpp"
+
+#include <Eigen/Geometry>
+
+#include "semap/estimation/so3.hpp"
+
+namespace semap::estimation {
+
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// Left-multiplies the rot/vel/pos row blocks of m by the gravity shear F(t).
+template <typename M>
+void shear_rows(M& m, const Vector3d& g, double t) {
+  for (int c = 0; c < m.cols(); ++c) {
+    const Vector3d gr = t * g.cross(Vector3d(m.template block<3, 1>(kRot, c)));
+    m.template block<3, 1>(kPos, c) += t * m.template block<3, 1>(kVel, c) + (0.5 * t) * gr;
+    m.template block<3, 1>(kVel, c) += gr;
+  }
+}
+
+// Right-multiplies the 9 columns of m by F(t)^T, as whole-column AXPYs ([g]x has a zero
+// diagonal, so each column takes two rotation columns).
+void shear_columns(PaddedBlock9& m, const Vector3d& g, double t) {
+  const Matrix3d d1 = t * skew(g);
+  const Matrix3d d2 = (0.5 * t) * d1;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const int k = (i + 2) % 3;
+    m.col(kPos + i) +=
+        t * m.col(kVel + i) + d2(i, j) * m.col(kRot + j) + d2(i, k) * m.col(kRot + k);
+    m.col(kVel + i) += d1(i, j) * m.col(kRot + j) + d1(i, k) * m.col(kRot + k);
+  }
+}
+
+// Indices in the moment vector z = (c, e, 1, t).
+constexpr int kMomentC = 0;
+constexpr int kMomentE = 3;
+constexpr int kMomentOne = 6;
+constexpr int kMomentTime = 7;
+
+}  // namespace
+
+Matrix15 WorldCovariance::dense() const {
+  Matrix15 p;
+  p.topLeftCorner<9, 9>() = a.topRows<9>();
+  p.topRightCorner<9, 6>() = b.topRows<9>();
+  p.bottomLeftCorner<6, 9>() = b.topRows<9>().transpose();
+  p.bottomRightCorner<6, 6>() = c;
+  return p;
+}
+
+void WorldCovariance::set(const Matrix15& p) {
+  a.topRows<9>() = p.topLeftCorner<9, 9>();
+  a.row(9).setZero();
+  b.topRows<9>() = p.topRightCorner<9, 6>();
+  b.row(9).setZero();
+  c = p.bottomRightCorner<6, 6>();
+}
+
+CovarianceWindow::CovarianceWindow(const ImuNoise& noise, const Vector3d& gravity)
+    : gravity_(gravity),
+      qg_(noise.gyro_noise * noise.gyro_noise),
+      qa_(noise.accel_noise * noise.accel_noise),
+      qp_(noise.position_process * noise.position_process) {
+  qb_.head<3>().setConstant(noise.gyro_bias_walk * noise.gyro_bias_walk);
+  qb_.tail<3>().setConstant(noise.accel_bias_walk * noise.accel_bias_walk);
+}
+
+void CovarianceWindow::clear() {
+  steps_ = 0;
+  elapsed_ = 0.0;
+  h_.setZero();
+  k_.setZero();
+  y_.setZero();
+  moments_.setZero();
+}
+
+void CovarianceWindow::add(const InekfImuStep& step) {
+  const double dt = step.dt;
+  if (steps_ > 0) {  // H_0 = 0: the first step adds nothing to K and Y
+    k_ += dt * h_;
+    // Y += H Qb H^T dt; the accel-bias columns of H have no rotation rows.
+    const Eigen::Matrix<double, 10, 3> hg = (qb_(0) * dt) * h_.leftCols<3>();
+    y_.noalias() += hg.lazyProduct(h_.topLeftCorner<9, 3>().transpose());
+    const Eigen::Matrix<double, 6, 3> ha = h_.block<6, 3>(kVel, 3);
+    y_.block<6, 6>(kVel, kVel).noalias() += ((qb_(3) * dt) * ha).lazyProduct(ha.transpose());
+  }
+  h_ += step.coupling;
+  Eigen::Matrix<double, 8, 1> z;
+  z << step.c, step.e, 1.0, step.t0;
+  moments_.noalias() += (dt * z) * z.transpose();
+  elapsed_ += dt;
+  ++steps_;
+}
+
+void CovarianceWindow::apply(WorldCovariance& p) const {
+  if (empty()) return;
+  const double t = elapsed_;
+  Eigen::Matrix<double, 6, 6> c_end = p.c;
+  c_end.diagonal() += qb_ * t;
+  const PaddedBlock6 u = p.b - k_ * qb_.asDiagonal();
+  PaddedBlock6 hc;
+  hc.noalias() = h_.lazyProduct(c_end);
+  const PaddedBlock6 w = u + 0.5 * hc;
+  p.b = u + hc;
+  shear_rows(p.b, gravity_, t);
+  PaddedBlock9 wh;  // W H^T; the rotation rows of H have no accel-bias part
+  wh.leftCols<3>().noalias() = w.leftCols<3>().lazyProduct(h_.block<3, 3>(kRot, 0).transpose());
+  wh.rightCols<6>().noalias() = w.lazyProduct(h_.middleRows<6>(kVel).transpose());
+  p.a += wh + y_;
+  p.a.topRows<9>() += wh.topRows<9>().transpose();
+  shear_rows(p.a, gravity_, t);
+  shear_columns(p.a, gravity_, t);
+  add_white_noise(p.a);
+  p.c = c_end;
+}
+
+void CovarianceWindow::add_white_noise(PaddedBlock9& a) const {
+  // a_k = c_k + g T and b_k = e_k + c_k T + g T^2 / 2 are rows of L z_k; their weighted second
+  // moments are L M L^T, their weighted sums L M e_one.
+  const double t = elapsed_;
+  Eigen::Matrix<double, 6, 8> l = Eigen::Matrix<double, 6, 8>::Zero();
+  l.block<3, 3>(0, kMomentC).setIdentity();
+  l.block<3, 1>(0, kMomentOne) = t * gravity_;
+  l.block<3, 3>(3, kMomentC).diagonal().setConstant(t);
+  l.block<3, 3>(3, kMomentE).setIdentity();
+  l.block<3, 1>(3, kMomentOne) = (0.5 * t * t) * gravity_;
+  Eigen::Matrix<double, 6, 8> lm;
+  lm.noalias() = l * moments_;
+  Eigen::Matrix<double, 6, 6> s;
+  s.noalias() = lm * l.transpose();
+  const Vector3d sum_a = lm.block<3, 1>(0, kMomentOne);
+  const Vector3d sum_b = lm.block<3, 1>(3, kMomentOne);
+  const double s0 = moments_(kMomentOne, kMomentOne);      // sum dt
+  const double s1 = moments_(kMomentOne, kMomentTime);     // sum t_k dt
+  const double s2 = moments_(kMomentTime, kMomentTime);    // sum t_k^2 dt
+  const double tau1 = t * s0 - s1;                          // sum tau_k dt
+  const double tau2 = t * t * s0 - 2.0 * t * s1 + s2;       // sum tau_k^2 dt
+  // Gyro noise qg [I; [a]x; [b]x][...]^T with [b]x [a]x^T = (a.b) I - a b^T; accel noise
+  // qa [0; I; tau I][...]^T; position noise qp on the position block.
+  const Matrix3d ax = qg_ * skew(sum_a);
+  const Matrix3d bx = qg_ * skew(sum_b);
+  a.block<3, 3>(kRot, kRot).diagonal().array() += qg_ * s0;
+  a.block<3, 3>(kVel, kRot) += ax;
+  a.block<3, 3>(kRot, kVel) -= ax;
+  a.block<3, 3>(kPos, kRot) += bx;
+  a.block<3, 3>(kRot, kPos) -= bx;
+  const auto saa = s.block<3, 3>(0, 0);
+  const auto sab = s.block<3, 3>(0, 3);  // sum dt a b^T
+  const auto sbb = s.block<3, 3>(3, 3);
+  Matrix3d vv = -qg_ * saa;
+  vv.diagonal().array() += qg_ * saa.trace() + qa_ * s0;
+  a.block<3, 3>(kVel, kVel) += vv;
+  Matrix3d pv = -qg_ * sab;
+  pv.diagonal().array() += qg_ * sab.trace() + qa_ * tau1;
+  a.block<3, 3>(kPos, kVel) += pv;
+  a.block<3, 3>(kVel, kPos) += pv.transpose();
+  Matrix3d pp = -qg_ * sbb;
+  pp.diagonal().array() += qg_ * sbb.trace() + qa_ * tau2 + qp_ * s0;
+  a.block<3, 3>(kPos, kPos) += pp;
+}
+
+}  // namespace semap::estimation
