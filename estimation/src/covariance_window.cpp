@@ -54,9 +54,9 @@ Matrix15 WorldCovariance::dense() const {
 
 void WorldCovariance::set(const Matrix15& p) {
   a.topRows<9>() = p.topLeftCorner<9, 9>();
-  a.row(9).setZero();
+  a.bottomRows<kPaddedRows - 9>().setZero();
   b.topRows<9>() = p.topRightCorner<9, 6>();
-  b.row(9).setZero();
+  b.bottomRows<kPaddedRows - 9>().setZero();
   c = p.bottomRightCorner<6, 6>();
 }
 
@@ -83,14 +83,17 @@ void CovarianceWindow::add(const InekfImuStep& step) {
   if (steps_ > 0) {  // H_0 = 0: the first step adds nothing to K and Y
     k_ += dt * h_;
     // Y += H Qb H^T dt; the accel-bias columns of H have no rotation rows.
-    const Eigen::Matrix<double, 10, 3> hg = (qb_(0) * dt) * h_.leftCols<3>();
+    const Eigen::Matrix<double, kPaddedRows, 3> hg = (qb_(0) * dt) * h_.leftCols<3>();
     y_.noalias() += hg.lazyProduct(h_.topLeftCorner<9, 3>().transpose());
     const Eigen::Matrix<double, 6, 3> ha = h_.block<6, 3>(kVel, 3);
     y_.block<6, 6>(kVel, kVel).noalias() += ((qb_(3) * dt) * ha).lazyProduct(ha.transpose());
   }
   h_ += step.coupling;
   Eigen::Matrix<double, 8, 1> z;
-  z << step.c, step.e, 1.0, step.t0;
+  z.segment<3>(kMomentC) = step.c;
+  z.segment<3>(kMomentE) = step.e;
+  z(kMomentOne) = 1.0;
+  z(kMomentTime) = step.t0;
   moments_.noalias() += (dt * z) * z.transpose();
   elapsed_ += dt;
   ++steps_;
@@ -129,9 +132,9 @@ void CovarianceWindow::add_white_noise(PaddedBlock9& a) const {
   l.block<3, 3>(3, kMomentE).setIdentity();
   l.block<3, 1>(3, kMomentOne) = (0.5 * t * t) * gravity_;
   Eigen::Matrix<double, 6, 8> lm;
-  lm.noalias() = l * moments_;
+  lm.noalias() = l.lazyProduct(moments_);
   Eigen::Matrix<double, 6, 6> s;
-  s.noalias() = lm * l.transpose();
+  s.noalias() = lm.lazyProduct(l.transpose());
   const Vector3d sum_a = lm.block<3, 1>(0, kMomentOne);
   const Vector3d sum_b = lm.block<3, 1>(3, kMomentOne);
   const double s0 = moments_(kMomentOne, kMomentOne);      // sum dt

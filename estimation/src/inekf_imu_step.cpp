@@ -192,7 +192,7 @@ InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const V
   Eigen::Matrix<double, 3, 6> world;
   world.noalias() = r * body;
   auto& g = step.coupling;
-  g.row(9).setZero();
+  g.bottomRows<kPaddedRows - 9>().setZero();
   g.block<3, 3>(kRot, 0) = -a1;
   g.block<3, 3>(kVel, 0) = -world.leftCols<3>();
   g.block<3, 3>(kPos, 0) = -world.rightCols<3>();

@@ -7,10 +7,11 @@
 namespace semap::estimation {
 
 using Matrix9 = Eigen::Matrix<double, 9, 9>;
-// Blocks of the world-form covariance with a zero tenth row, so that every column is whole
-// SIMD packets.
-using PaddedBlock9 = Eigen::Matrix<double, 10, 9>;
-using PaddedBlock6 = Eigen::Matrix<double, 10, 6>;
+// Blocks of the world-form covariance padded with zero rows to 12, so that every column is
+// three whole AVX packets (with 10 rows Eigen falls back to SSE packets).
+inline constexpr int kPaddedRows = 12;
+using PaddedBlock9 = Eigen::Matrix<double, kPaddedRows, 9>;
+using PaddedBlock6 = Eigen::Matrix<double, kPaddedRows, 6>;
 
 // Adjoint of X = (R, v, p) in SE_2(3): exp(Ad_X xi) X = X exp(xi).
 Matrix9 se23_adjoint(const Eigen::Matrix3d& r, const Eigen::Vector3d& v, const Eigen::Vector3d& p);
@@ -40,8 +41,8 @@ struct InekfImuStep {
   Eigen::Matrix3d rotation;  // R+
   Eigen::Vector3d dv, dp;    // R Gamma1 a dt and R Gamma2 a dt^2 (world, without gravity)
   Eigen::Vector3d c, e;      // free-fall velocity and position at the start of the step
-  // F(-t1) G (rows: rot, vel, pos errors; columns: gyro, accel bias errors) with a zero tenth
-  // row.
+  // F(-t1) G (rows: rot, vel, pos errors, then zero padding; columns: gyro, accel bias
+  // errors).
   PaddedBlock6 coupling;
   double dt = 0.0;
   double t0 = 0.0;
