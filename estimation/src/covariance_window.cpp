@@ -137,11 +137,11 @@ void CovarianceWindow::add_white_noise(PaddedBlock9& a) const {
   s.noalias() = lm.lazyProduct(l.transpose());
   const Vector3d sum_a = lm.block<3, 1>(0, kMomentOne);
   const Vector3d sum_b = lm.block<3, 1>(3, kMomentOne);
-  const double s0 = moments_(kMomentOne, kMomentOne);      // sum dt
-  const double s1 = moments_(kMomentOne, kMomentTime);     // sum t_k dt
-  const double s2 = moments_(kMomentTime, kMomentTime);    // sum t_k^2 dt
-  const double tau1 = t * s0 - s1;                          // sum tau_k dt
-  const double tau2 = t * t * s0 - 2.0 * t * s1 + s2;       // sum tau_k^2 dt
+  const double s0 = moments_(kMomentOne, kMomentOne);    // sum dt
+  const double s1 = moments_(kMomentOne, kMomentTime);   // sum t_k dt
+  const double s2 = moments_(kMomentTime, kMomentTime);  // sum t_k^2 dt
+  const double tau1 = t * s0 - s1;                       // sum tau_k dt
+  const double tau2 = t * t * s0 - 2.0 * t * s1 + s2;    // sum tau_k^2 dt
   // Gyro noise qg [I; [a]x; [b]x][...]^T with [b]x [a]x^T = (a.b) I - a b^T; accel noise
   // qa [0; I; tau I][...]^T; position noise qp on the position block.
   const Matrix3d ax = qg_ * skew(sum_a);

@@ -153,7 +153,7 @@ InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const V
   Matrix3d rk2 = psi * phi.transpose();
   rk2 -= theta2 * r;
   step.rotation = r + co.a0 * rk + co.b0 * rk2;
-  const Matrix3d a1 = dt * (r + co.a1 * rk + co.b1 * rk2);                // R Gamma1 dt
+  const Matrix3d a1 = dt * (r + co.a1 * rk + co.b1 * rk2);               // R Gamma1 dt
   const Matrix3d a2 = (dt * dt) * (0.5 * r + co.a2 * rk + co.b2 * rk2);  // R Gamma2 dt^2
   step.dv.noalias() = a1 * a;
   step.dp.noalias() = a2 * a;
@@ -178,7 +178,7 @@ InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const V
   // x_tau = sum_kappa S(kappa, tau) b_kappa, i.e. X = basis S with S stored row-major.
   const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s1(s.data());
   const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s2(s.data() + 9);
-  const Matrix3d x1 = (dt * dt) * (basis * s1);        // J1 = C(x1)
+  const Matrix3d x1 = (dt * dt) * (basis * s1);       // J1 = C(x1)
   const Matrix3d x2 = (dt * dt * dt) * (basis * s2);  // J2 = C(x2)
   const Matrix3d k = skew(phi);
   const Eigen::RowVector3d gamma1_terms(dt, dt * co.a1, dt * co.b1);

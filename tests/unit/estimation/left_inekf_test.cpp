@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
 
@@ -185,6 +186,125 @@ TEST(LeftInekf, PropagationIsInvariantAndLogLinear) {
   }
   // Same error evolution from two different estimates: the error dynamics are autonomous.
   EXPECT_LT((results[0] - results[1]).norm(), 1e-9);
+}
+
+// Noise large enough that every term of the deferred covariance (white noise carried to the
+// end of the window, bias random walk and its coupling) shows at the compared precision.
+FilterParams loud_params() {
+  FilterParams params;
+  params.noise.gyro_noise = 2e-2;
+  params.noise.accel_noise = 0.2;
+  params.noise.gyro_bias_walk = 1e-2;
+  params.noise.accel_bias_walk = 0.1;
+  params.noise.position_process = 0.05;
+  return params;
+}
+
+double relative_difference(const Matrix15& a, const Matrix15& b) {
+  return (a - b).norm() / b.norm();
+}
+
+bool identical(const NavState& a, const NavState& b) {
+  return a.rotation == b.rotation && a.velocity == b.velocity && a.position == b.position &&
+         a.gyro_bias == b.gyro_bias && a.accel_bias == b.accel_bias;
+}
+
+// The deferred covariance (windows of up to 20 steps, formed only when read) against the
+// textbook per-step propagation P <- expm(A dt) (P + Q dt) expm(A dt)^T in left-invariant
+// coordinates, and against the filter propagating at every step, over 1000 random steps
+// with random step lengths and queries at random times. Fast enough to pass the 100 m origin
+// moves too.
+TEST(LeftInekf, DeferredCovarianceEqualsPerStepPropagation) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const FilterParams params = loud_params();
+  NavState start = some_state();
+  start.velocity = Vector3d(25.0, -8.0, 1.0);
+  start.gyro_bias = Vector3d(0.01, -0.02, 0.005);
+  start.accel_bias = Vector3d(0.1, 0.05, -0.2);
+  LeftInekf deferred(params);
+  LeftInekf per_step(params, 1);
+  const Matrix15 p0 = random_spd(rng) * 0.01;
+  deferred.reset(start, p0);
+  per_step.reset(start, p0);
+  Matrix15 reference = deferred.covariance();
+  const Matrix15 q = process_noise_diagonal(params.noise).asDiagonal();
+  int queries = 0;
+  double worst = 0.0;
+  for (int k = 0; k < 1000; ++k) {
+    const Vector3d gyro = start.gyro_bias + Vector3d(0.3 * n(rng), 0.3 * n(rng), 0.5 * n(rng));
+    const Vector3d accel = start.accel_bias + Vector3d(2.0 * n(rng), 2.0 * n(rng), 9.8 + n(rng));
+    const double dt = 0.002 + 0.018 * u(rng);
+    deferred.propagate(gyro, accel, dt);
+    per_step.propagate(gyro, accel, dt);
+    const Matrix15 phi =
+        (error_dynamics(gyro - start.gyro_bias, accel - start.accel_bias) * dt).exp();
+    reference = phi * (reference + q * dt) * phi.transpose();
+    ASSERT_TRUE(identical(deferred.state(), per_step.state())) << "step " << k;
+    if (u(rng) < 0.1 || k == 999) {
+      ++queries;
+      const Matrix15 got = deferred.covariance();
+      worst = std::max(worst, relative_difference(got, reference));
+      EXPECT_LT(relative_difference(got, reference), 1e-9) << "step " << k;
+      EXPECT_LT(relative_difference(got, per_step.covariance()), 1e-9) << "step " << k;
+      EXPECT_LT(
+          (deferred.position_covariance_world() - per_step.position_covariance_world()).norm(),
+          1e-9 * per_step.position_covariance_world().norm());
+      EXPECT_LT(
+          (deferred.rotation_covariance_world() - per_step.rotation_covariance_world()).norm(),
+          1e-9 * per_step.rotation_covariance_world().norm());
+    }
+  }
+  EXPECT_GT(queries, 50);
+  EXPECT_GT((deferred.state().position - start.position).norm(), 200.0);  // origin moved
+  std::printf("deferred vs per-step expm covariance: worst relative difference %.2e\n", worst);
+}
+
+// Corrections end the window; reading the covariance does not, and does not change the result.
+TEST(LeftInekf, DeferredFilterWithCorrectionsMatchesPerStepFilter) {
+  std::mt19937_64 rng(23);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const FilterParams params = loud_params();
+  const double gate2 = chi_square_quantile(0.999, 3);
+  LeftInekf deferred(params);
+  LeftInekf per_step(params, 1);
+  LeftInekf unread(params);  // never queried between corrections
+  const Matrix15 p0 = random_spd(rng) * 0.01;
+  deferred.reset(some_state(), p0);
+  per_step.reset(some_state(), p0);
+  unread.reset(some_state(), p0);
+  const Vector3d lever(0.3, 0.1, 1.2);
+  for (int k = 0; k < 1000; ++k) {
+    const Vector3d gyro(0.2 * n(rng), 0.2 * n(rng), 0.3 + 0.2 * n(rng));
+    const Vector3d accel(n(rng), n(rng), 9.8 + 0.3 * n(rng));
+    const double dt = 0.005 + 0.01 * u(rng);
+    for (LeftInekf* f : {&deferred, &per_step, &unread}) f->propagate(gyro, accel, dt);
+    if (u(rng) < 0.3) static_cast<void>(deferred.covariance());
+    if (u(rng) < 0.1) {
+      const NavState x = per_step.state();
+      const Vector3d y = x.position + x.rotation * lever + 0.3 * Vector3d(n(rng), n(rng), n(rng));
+      const Matrix3d noise = Matrix3d::Identity() * 0.09;
+      const CorrectionResult a = deferred.correct_position(y, noise, lever, gate2);
+      const CorrectionResult b = per_step.correct_position(y, noise, lever, gate2);
+      unread.correct_position(y, noise, lever, gate2);
+      ASSERT_EQ(a.accepted, b.accepted);
+      EXPECT_NEAR(a.mahalanobis2, b.mahalanobis2, 1e-9 * b.mahalanobis2);
+      if (u(rng) < 0.3) {
+        const Vector3d vel = x.velocity + 0.1 * Vector3d(n(rng), n(rng), n(rng));
+        for (LeftInekf* f : {&deferred, &per_step, &unread}) {
+          f->correct_velocity(vel, Matrix3d::Identity() * 0.01, gate2);
+        }
+      }
+    }
+  }
+  const Vector15 e = deferred.error_from(per_step.state());
+  EXPECT_LT(e.norm(), 1e-9);
+  EXPECT_LT(relative_difference(deferred.covariance(), per_step.covariance()), 1e-9);
+  // Reading the covariance caches it but leaves the filter's arithmetic alone.
+  EXPECT_TRUE(identical(deferred.state(), unread.state()));
+  EXPECT_TRUE(deferred.covariance() == unread.covariance());
 }
 
 TEST(LeftInekf, GatesFiftyMetreJumpAndAcceptsConsistentFix) {

@@ -28,7 +28,8 @@ Matrix9 gravity_shear(const Eigen::Vector3d& gravity, double t);
 
 // One zero-order-hold IMU step of the Left-InEKF from (R, v, p) with bias-corrected rate w
 // and specific force a over dt:
-//   R+ = R Gamma0(w dt),  v+ = v + R Gamma1 a dt + g dt,  p+ = p + v dt + R Gamma2 a dt^2 + g dt^2/2.
+//   R+ = R Gamma0(w dt),  v+ = v + R Gamma1 a dt + g dt,  p+ = p + v dt + R Gamma2 a dt^2 + g
+//   dt^2/2.
 // Its error transition for world-aligned errors xi_w = Ad_X xi (Phi_w = T(X+) Phi T(X)^-1) is
 // [[F(dt), G], [0, I]]: only the 9x6 coupling G to the bias errors depends on the motion.
 //
