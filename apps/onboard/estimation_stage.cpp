@@ -84,10 +84,13 @@ bool EstimationStage::drain_sensors() {
 }
 
 void EstimationStage::pose_images() {
-  const auto newest = estimator_.initialised() ? estimator_.estimate() : std::nullopt;
+  // Only the filter time is needed here: estimate() would also form the covariance, which the
+  // InEKF defers until someone reads it.
+  const bool initialised = estimator_.initialised();
+  const common::Stamp newest = estimator_.filter_time();
   while (!pending_images_.empty()) {
     auto& image = pending_images_.front();
-    if (newest && image.stamp > newest->stamp) return;  // the filter has not got there yet
+    if (initialised && image.stamp > newest) return;  // the filter has not got there yet
     const auto pose = estimator_.pose_at(image.stamp);
     if (!pose) {
       ++local_.images_without_pose;
@@ -110,17 +113,20 @@ void EstimationStage::pose_images() {
 
 void EstimationStage::publish_pose() {
   if (!pose_sink_ || !estimator_.initialised()) return;
-  const auto estimate = estimator_.estimate();
-  if (!estimate || estimate->stamp < next_pose_publish_) return;
-  next_pose_publish_ = estimate->stamp + 1.0 / config_.dds.odometry_hz;
+  // The covariance is read only for a pose that is published (odometry rate).
+  const common::Stamp stamp = estimator_.filter_time();
+  if (stamp < next_pose_publish_) return;
+  next_pose_publish_ = stamp + 1.0 / config_.dds.odometry_hz;
+  const estimation::NavFilter& filter = estimator_.filter();
+  const estimation::NavState state = filter.state();
   PoseOutput out;
-  out.pose.stamp = estimate->stamp;
-  out.pose.orientation = Eigen::Quaterniond(estimate->state.rotation);
-  out.pose.position = estimate->state.position;
-  out.pose.velocity = estimate->state.velocity;
-  out.angular_velocity_body = last_imu_.gyro - estimate->state.gyro_bias;
-  out.position_covariance = estimate->position_covariance_world;
-  out.rotation_covariance = estimate->rotation_covariance_world;
+  out.pose.stamp = stamp;
+  out.pose.orientation = Eigen::Quaterniond(state.rotation);
+  out.pose.position = state.position;
+  out.pose.velocity = state.velocity;
+  out.angular_velocity_body = last_imu_.gyro - state.gyro_bias;
+  out.position_covariance = filter.position_covariance_world();
+  out.rotation_covariance = filter.rotation_covariance_world();
   pose_sink_(out);
   ++local_.poses_published;
 }
@@ -128,12 +134,13 @@ void EstimationStage::publish_pose() {
 void EstimationStage::share_stats() {
   local_.initialised = estimator_.initialised();
   local_.estimator = estimator_.counters();
-  if (const auto e = estimator_.estimate()) {
+  if (estimator_.initialised()) {
+    const estimation::NavState state = estimator_.filter().state();
     estimation::StampedPose p;
-    p.stamp = e->stamp;
-    p.orientation = Eigen::Quaterniond(e->state.rotation);
-    p.position = e->state.position;
-    p.velocity = e->state.velocity;
+    p.stamp = estimator_.filter_time();
+    p.orientation = Eigen::Quaterniond(state.rotation);
+    p.position = state.position;
+    p.velocity = state.velocity;
     local_.latest = p;
   }
   local_.anchor = estimator_.anchor();

@@ -55,6 +55,8 @@ class Estimator {
   void add_gnss(const common::GnssFix& fix);
 
   bool initialised() const { return initialised_; }
+  // State and covariance. The InEKF forms its covariance on demand, so callers that need only
+  // the state read filter_time() and filter().state() instead.
   std::optional<Estimate> estimate() const;
   // Pose at a stamp inside the kept history (slerp/lerp), empty outside.
   std::optional<StampedPose> pose_at(common::Stamp stamp) const { return history_.at(stamp); }
