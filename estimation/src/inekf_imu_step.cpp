@@ -87,14 +87,18 @@ int series_power(double theta) {
   return m;
 }
 
-// [x0]x + [x1]x [phi]x + [x2]x [phi]x^2, with [x]x [phi]x = phi x^T - (x.phi) I and
-// [x]x [phi]x^2 = phi (x cross phi)^T - (x.phi) [phi]x.
-Matrix3d collapsed_matrix(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2,
-                          const Vector3d& phi, const Matrix3d& phi_x) {
-  Matrix3d m = skew(x0) - x2.dot(phi) * phi_x;
-  m.noalias() += phi * (x1 + x2.cross(phi)).transpose();
-  m.diagonal().array() -= x1.dot(phi);
-  return m;
+// [x0]x + [x1]x [phi]x + [x2]x [phi]x^2 = [x0 - (x2.phi) phi]x + phi (x1 + x2 x phi)^T - (x1.phi)
+// I, from [x]x [phi]x = phi x^T - (x.phi) I and [x]x [phi]x^2 = phi (x cross phi)^T - (x.phi)
+// [phi]x.
+inline Matrix3d collapsed_matrix(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2,
+                                 const Vector3d& phi) {
+  const Vector3d m = x0 - x2.dot(phi) * phi;
+  const Vector3d n = x1 + x2.cross(phi);
+  const double d = x1.dot(phi);
+  Matrix3d c;
+  c << -d, -m.z(), m.y(), m.z(), -d, -m.x(), -m.y(), m.x(), -d;
+  c.noalias() += phi * n.transpose();
+  return c;
 }
 
 }  // namespace
@@ -175,27 +179,32 @@ InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const V
   basis.col(0) = a;
   basis.col(1) = phi.cross(a);
   basis.col(2) = phi.cross(basis.col(1));
-  // x_tau = sum_kappa S(kappa, tau) b_kappa, i.e. X = basis S with S stored row-major.
-  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s1(s.data());
-  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> s2(s.data() + 9);
-  const Matrix3d x1 = (dt * dt) * (basis * s1);       // J1 = C(x1)
-  const Matrix3d x2 = (dt * dt * dt) * (basis * s2);  // J2 = C(x2)
-  const Matrix3d k = skew(phi);
-  const Eigen::RowVector3d gamma1_terms(dt, dt * co.a1, dt * co.b1);
-  const Vector3d c_b = r.transpose() * step.c;
-  const Vector3d e_b = r.transpose() * step.e;
-  const Matrix3d zv = c_b * gamma1_terms + x1;
-  const Matrix3d zp = e_b * gamma1_terms + x2 - t1 * x1;
+  // x_tau = sum_kappa S(kappa, tau) b_kappa, i.e. X = basis S with S stored row-major; J1 and
+  // J2 - t1 J1 are the collapsed matrices of basis (dt^2 S1) and basis (dt^3 S2 - t1 dt^2 S1).
+  // Everything is negated here, so that the products below give -R (...) directly.
+  const double dt2 = dt * dt;
+  Eigen::Matrix<double, 3, 6, Eigen::RowMajor> coefficients;
+  const Eigen::Matrix<double, 9, 1> sv = (-dt2) * s.head<9>();
+  const Eigen::Matrix<double, 9, 1> sp = (-dt2 * dt) * s.tail<9>() - t1 * sv;
+  coefficients.leftCols<3>() =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sv.data());
+  coefficients.rightCols<3>() =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sp.data());
+  const Eigen::RowVector3d gamma1_terms(-dt, -dt * co.a1, -dt * co.b1);
+  Eigen::Matrix<double, 3, 6> z;
+  z.noalias() = basis * coefficients;
+  z.leftCols<3>().noalias() += (r.transpose() * step.c) * gamma1_terms;
+  z.rightCols<3>().noalias() += (r.transpose() * step.e) * gamma1_terms;
   Eigen::Matrix<double, 3, 6> body;
-  body.leftCols<3>() = collapsed_matrix(zv.col(0), zv.col(1), zv.col(2), phi, k);
-  body.rightCols<3>() = collapsed_matrix(zp.col(0), zp.col(1), zp.col(2), phi, k);
+  body.leftCols<3>() = collapsed_matrix(z.col(0), z.col(1), z.col(2), phi);
+  body.rightCols<3>() = collapsed_matrix(z.col(3), z.col(4), z.col(5), phi);
   Eigen::Matrix<double, 3, 6> world;
   world.noalias() = r * body;
   auto& g = step.coupling;
   g.bottomRows<kPaddedRows - 9>().setZero();
   g.block<3, 3>(kRot, 0) = -a1;
-  g.block<3, 3>(kVel, 0) = -world.leftCols<3>();
-  g.block<3, 3>(kPos, 0) = -world.rightCols<3>();
+  g.block<3, 3>(kVel, 0) = world.leftCols<3>();
+  g.block<3, 3>(kPos, 0) = world.rightCols<3>();
   g.block<3, 3>(kRot, 3).setZero();
   g.block<3, 3>(kVel, 3) = -a1;
   g.block<3, 3>(kPos, 3) = t1 * a1 - a2;
