@@ -35,6 +35,14 @@ void shear_columns(PaddedBlock9& m, const Vector3d& g, double t) {
   }
 }
 
+// Column c of y += hq h.row(c)^T over the first Rows rows and Ranks columns of h.
+template <int Rows, int Ranks>
+void add_outer_column(PaddedBlock9& y, const PaddedBlock6& hq, const PaddedBlock6& h, int c) {
+  // A lazy product, so that Eigen uses FMA packets (no automatic contraction in this build).
+  y.col(c).template head<Rows>().noalias() += hq.template topLeftCorner<Rows, Ranks>().lazyProduct(
+      h.template block<1, Ranks>(c, 0).transpose());
+}
+
 // Indices in the moment vector z = (c, e, 1, t).
 constexpr int kMomentC = 0;
 constexpr int kMomentE = 3;
@@ -82,11 +90,13 @@ void CovarianceWindow::add(const InekfImuStep& step) {
   const double dt = step.dt;
   if (steps_ > 0) {  // H_0 = 0: the first step adds nothing to K and Y
     k_ += dt * h_;
-    // Y += H Qb H^T dt; the accel-bias columns of H have no rotation rows.
-    const Eigen::Matrix<double, kPaddedRows, 3> hg = (qb_(0) * dt) * h_.leftCols<3>();
-    y_.noalias() += hg.lazyProduct(h_.topLeftCorner<9, 3>().transpose());
-    const Eigen::Matrix<double, 6, 3> ha = h_.block<6, 3>(kVel, 3);
-    y_.block<6, 6>(kVel, kVel).noalias() += ((qb_(3) * dt) * ha).lazyProduct(ha.transpose());
+    // Y += H Qb H^T dt on the upper block triangle (mirrored in apply): columns of block b
+    // take rows 0..3b+2 rounded up to whole packets. Rotation rows have no accel-bias part.
+    const Eigen::Matrix<double, 6, 1> weights = qb_ * dt;
+    const PaddedBlock6 hq = h_ * weights.asDiagonal();
+    for (int c = kRot; c < kRot + 3; ++c) add_outer_column<4, 3>(y_, hq, h_, c);
+    for (int c = kVel; c < kVel + 3; ++c) add_outer_column<8, 6>(y_, hq, h_, c);
+    for (int c = kPos; c < kPos + 3; ++c) add_outer_column<kPaddedRows, 6>(y_, hq, h_, c);
   }
   h_ += step.coupling;
   Eigen::Matrix<double, 8, 1> z;
@@ -113,7 +123,11 @@ void CovarianceWindow::apply(WorldCovariance& p) const {
   PaddedBlock9 wh;  // W H^T; the rotation rows of H have no accel-bias part
   wh.leftCols<3>().noalias() = w.leftCols<3>().lazyProduct(h_.block<3, 3>(kRot, 0).transpose());
   wh.rightCols<6>().noalias() = w.lazyProduct(h_.middleRows<6>(kVel).transpose());
-  p.a += wh + y_;
+  PaddedBlock9 y = y_;  // mirrored from its upper block triangle
+  y.block<3, 3>(kVel, kRot) = y_.block<3, 3>(kRot, kVel).transpose();
+  y.block<3, 3>(kPos, kRot) = y_.block<3, 3>(kRot, kPos).transpose();
+  y.block<3, 3>(kPos, kVel) = y_.block<3, 3>(kVel, kPos).transpose();
+  p.a += wh + y;
   p.a.topRows<9>() += wh.topRows<9>().transpose();
   shear_rows(p.a, gravity_, t);
   shear_columns(p.a, gravity_, t);
