@@ -233,11 +233,14 @@ Eigen::Matrix3d LeftInekf::rotation_covariance_world() const {
 }
 
 Eigen::Matrix3d LeftInekf::position_covariance_world() const {
-  // R xi_p = rho_p - [p - o]x phi.
-  Eigen::Matrix<double, 3, 9> l = Eigen::Matrix<double, 3, 9>::Zero();
-  l.block<3, 3>(0, kRot) = -skew(p_pos_ - origin_);
-  l.block<3, 3>(0, kPos).setIdentity();
-  return l * settled().a.topRows<9>() * l.transpose();
+  // R xi_p = rho_p - [p - o]x phi, so the covariance is L A L^T with L = [-[p - o]x, 0, I],
+  // in 3x3 blocks.
+  const auto& a = settled().a;
+  const Matrix3d px = skew(p_pos_ - origin_);
+  const Matrix3d pa = px * a.block<3, 3>(kRot, kPos);  // [p]x A_rp
+  Matrix3d out = a.block<3, 3>(kPos, kPos) - pa - pa.transpose();
+  out.noalias() += px * a.block<3, 3>(kRot, kRot) * px.transpose();
+  return out;
 }
 
 }  // namespace semap::estimation
