@@ -81,7 +81,7 @@ void CovarianceWindow::clear() {
   steps_ = 0;
   elapsed_ = 0.0;
   h_.setZero();
-  k_.setZero();
+  kq_.setZero();
   y_.setZero();
   moments_.setZero();
 }
@@ -89,11 +89,11 @@ void CovarianceWindow::clear() {
 void CovarianceWindow::add(const InekfImuStep& step) {
   const double dt = step.dt;
   if (steps_ > 0) {  // H_0 = 0: the first step adds nothing to K and Y
-    k_ += dt * h_;
     // Y += H Qb H^T dt on the upper block triangle (mirrored in apply): columns of block b
     // take rows 0..3b+2 rounded up to whole packets. Rotation rows have no accel-bias part.
     const Eigen::Matrix<double, 6, 1> weights = qb_ * dt;
     const PaddedBlock6 hq = h_ * weights.asDiagonal();
+    kq_ += hq;
     for (int c = kRot; c < kRot + 3; ++c) add_outer_column<4, 3>(y_, hq, h_, c);
     for (int c = kVel; c < kVel + 3; ++c) add_outer_column<8, 6>(y_, hq, h_, c);
     for (int c = kPos; c < kPos + 3; ++c) add_outer_column<kPaddedRows, 6>(y_, hq, h_, c);
@@ -114,7 +114,7 @@ void CovarianceWindow::apply(WorldCovariance& p) const {
   const double t = elapsed_;
   Eigen::Matrix<double, 6, 6> c_end = p.c;
   c_end.diagonal() += qb_ * t;
-  const PaddedBlock6 u = p.b - k_ * qb_.asDiagonal();
+  const PaddedBlock6 u = p.b - kq_;
   PaddedBlock6 hc;
   hc.noalias() = h_.lazyProduct(c_end);
   const PaddedBlock6 w = u + 0.5 * hc;

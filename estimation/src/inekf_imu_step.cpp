@@ -183,16 +183,13 @@ InekfImuStep InekfImuStep::compute(const Matrix3d& r, const Vector3d& v, const V
   // J2 - t1 J1 are the collapsed matrices of basis (dt^2 S1) and basis (dt^3 S2 - t1 dt^2 S1).
   // Everything is negated here, so that the products below give -R (...) directly.
   const double dt2 = dt * dt;
-  Eigen::Matrix<double, 3, 6, Eigen::RowMajor> coefficients;
   const Eigen::Matrix<double, 9, 1> sv = (-dt2) * s.head<9>();
   const Eigen::Matrix<double, 9, 1> sp = (-dt2 * dt) * s.tail<9>() - t1 * sv;
-  coefficients.leftCols<3>() =
-      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sv.data());
-  coefficients.rightCols<3>() =
-      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(sp.data());
+  using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   const Eigen::RowVector3d gamma1_terms(-dt, -dt * co.a1, -dt * co.b1);
   Eigen::Matrix<double, 3, 6> z;
-  z.noalias() = basis * coefficients;
+  z.leftCols<3>().noalias() = basis * Eigen::Map<const RowMajor3>(sv.data());
+  z.rightCols<3>().noalias() = basis * Eigen::Map<const RowMajor3>(sp.data());
   z.leftCols<3>().noalias() += (r.transpose() * step.c) * gamma1_terms;
   z.rightCols<3>().noalias() += (r.transpose() * step.e) * gamma1_terms;
   Eigen::Matrix<double, 3, 6> body;

@@ -19,13 +19,16 @@ GammaCoefficients gamma_coefficients(double theta) {
   GammaCoefficients c{};
   const double t2 = theta * theta;
   if (theta < kSeriesBelow) {
-    const double t4 = t2 * t2;
-    const double t6 = t4 * t2;
-    const double sinc = 1.0 - t2 / 6.0 + t4 / 120.0 - t6 / 5040.0;              // sin/t
-    const double cosc = 0.5 - t2 / 24.0 + t4 / 720.0 - t6 / 40320.0;            // (1-cos)/t^2
-    const double sinc3 = 1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 - t6 / 362880.0;  // (t-sin)/t^3
+    // Horner forms with reciprocal factorials: no division on the per-step path.
+    const auto series = [t2](double c0, double c1, double c2, double c3) {
+      return c0 - t2 * (c1 - t2 * (c2 - t2 * c3));
+    };
+    const double sinc = series(1.0, 1.0 / 6.0, 1.0 / 120.0, 1.0 / 5040.0);    // sin/t
+    const double cosc = series(0.5, 1.0 / 24.0, 1.0 / 720.0, 1.0 / 40320.0);  // (1-cos)/t^2
+    const double sinc3 =
+        series(1.0 / 6.0, 1.0 / 120.0, 1.0 / 5040.0, 1.0 / 362880.0);  // (t-sin)/t^3
     const double cosc4 =
-        1.0 / 24.0 - t2 / 720.0 + t4 / 40320.0 - t6 / 3628800.0;  // (t^2+2cos-2)/(2t^4)
+        series(1.0 / 24.0, 1.0 / 720.0, 1.0 / 40320.0, 1.0 / 3628800.0);  // (t^2+2cos-2)/(2t^4)
     c = {sinc, cosc, cosc, sinc3, sinc3, cosc4};
     return c;
   }

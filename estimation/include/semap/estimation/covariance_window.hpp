@@ -59,7 +59,7 @@ class CovarianceWindow {
   int steps_ = 0;
   double elapsed_ = 0.0;
   PaddedBlock6 h_ = PaddedBlock6::Zero();
-  PaddedBlock6 k_ = PaddedBlock6::Zero();
+  PaddedBlock6 kq_ = PaddedBlock6::Zero();  // K Qb
   PaddedBlock9 y_ = PaddedBlock9::Zero();
   Eigen::Matrix<double, 8, 8> moments_ = Eigen::Matrix<double, 8, 8>::Zero();
 };
