@@ -120,15 +120,16 @@ void CovarianceWindow::apply(WorldCovariance& p) const {
   const PaddedBlock6 w = u + 0.5 * hc;
   p.b = u + hc;
   shear_rows(p.b, gravity_, t);
-  PaddedBlock9 wh;  // W H^T; the rotation rows of H have no accel-bias part
-  wh.leftCols<3>().noalias() = w.leftCols<3>().lazyProduct(h_.block<3, 3>(kRot, 0).transpose());
-  wh.rightCols<6>().noalias() = w.lazyProduct(h_.middleRows<6>(kVel).transpose());
-  PaddedBlock9 y = y_;  // mirrored from its upper block triangle
-  y.block<3, 3>(kVel, kRot) = y_.block<3, 3>(kRot, kVel).transpose();
-  y.block<3, 3>(kPos, kRot) = y_.block<3, 3>(kRot, kPos).transpose();
-  y.block<3, 3>(kPos, kVel) = y_.block<3, 3>(kVel, kPos).transpose();
-  p.a += wh + y;
-  p.a.topRows<9>() += wh.topRows<9>().transpose();
+  // A0 + W H^T + H W^T as two lazy products (FMA packets; a transposed add is scalar code).
+  p.a.noalias() += w.lazyProduct(h_.topRows<9>().transpose());
+  p.a.noalias() += h_.lazyProduct(w.topRows<9>().transpose());
+  // + Y: add_outer_column filled its upper block triangle rounded up to whole packets (rows
+  // 0-3 of the rotation columns, 0-7 of the velocity columns); mirror the rest.
+  p.a += y_;
+  for (int c = kRot; c < kRot + 3; ++c) {
+    for (int r = 4; r < 9; ++r) p.a(r, c) += y_(c, r);
+  }
+  for (int c = kVel; c < kVel + 3; ++c) p.a(8, c) += y_(c, 8);
   shear_rows(p.a, gravity_, t);
   shear_columns(p.a, gravity_, t);
   add_white_noise(p.a);
@@ -136,26 +137,32 @@ void CovarianceWindow::apply(WorldCovariance& p) const {
 }
 
 void CovarianceWindow::add_white_noise(PaddedBlock9& a) const {
-  // a_k = c_k + g T and b_k = e_k + c_k T + g T^2 / 2 are rows of L z_k; their weighted second
-  // moments are L M L^T, their weighted sums L M e_one.
+  // a_k = c_k + g T and b_k = e_k + c_k T + g h (h = T^2 / 2): their dt-weighted sums and
+  // second moments expand into the moments of (c, e, 1).
   const double t = elapsed_;
-  Eigen::Matrix<double, 6, 8> l = Eigen::Matrix<double, 6, 8>::Zero();
-  l.block<3, 3>(0, kMomentC).setIdentity();
-  l.block<3, 1>(0, kMomentOne) = t * gravity_;
-  l.block<3, 3>(3, kMomentC).diagonal().setConstant(t);
-  l.block<3, 3>(3, kMomentE).setIdentity();
-  l.block<3, 1>(3, kMomentOne) = (0.5 * t * t) * gravity_;
-  Eigen::Matrix<double, 6, 8> lm;
-  lm.noalias() = l.lazyProduct(moments_);
-  Eigen::Matrix<double, 6, 6> s;
-  s.noalias() = lm.lazyProduct(l.transpose());
-  const Vector3d sum_a = lm.block<3, 1>(0, kMomentOne);
-  const Vector3d sum_b = lm.block<3, 1>(3, kMomentOne);
+  const double h = 0.5 * t * t;
+  const Vector3d& g = gravity_;
+  const auto m_cc = moments_.block<3, 3>(kMomentC, kMomentC);
+  const auto m_ce = moments_.block<3, 3>(kMomentC, kMomentE);  // sum dt c e^T
+  const auto m_ee = moments_.block<3, 3>(kMomentE, kMomentE);
+  const Vector3d m_c = moments_.block<3, 1>(kMomentC, kMomentOne);
+  const Vector3d m_e = moments_.block<3, 1>(kMomentE, kMomentOne);
   const double s0 = moments_(kMomentOne, kMomentOne);    // sum dt
   const double s1 = moments_(kMomentOne, kMomentTime);   // sum t_k dt
   const double s2 = moments_(kMomentTime, kMomentTime);  // sum t_k^2 dt
-  const double tau1 = t * s0 - s1;                       // sum tau_k dt
-  const double tau2 = t * t * s0 - 2.0 * t * s1 + s2;    // sum tau_k^2 dt
+  const Matrix3d gg = s0 * g * g.transpose();
+  const Matrix3d cg = m_c * g.transpose();
+  const Matrix3d eg = m_e * g.transpose();
+  const Matrix3d cg_sym = cg + cg.transpose();
+  const Vector3d sum_a = m_c + (t * s0) * g;
+  const Vector3d sum_b = m_e + t * m_c + (h * s0) * g;
+  const Matrix3d saa = m_cc + t * cg_sym + (t * t) * gg;
+  const Matrix3d sab = m_ce + t * m_cc + h * cg + t * eg.transpose() + (t * t) * cg.transpose() +
+                       (t * h) * gg;  // sum dt a b^T
+  const Matrix3d sbb = m_ee + t * (m_ce + m_ce.transpose()) + (t * t) * m_cc +
+                       h * (eg + eg.transpose()) + (t * h) * cg_sym + (h * h) * gg;
+  const double tau1 = t * s0 - s1;                     // sum tau_k dt
+  const double tau2 = t * t * s0 - 2.0 * t * s1 + s2;  // sum tau_k^2 dt
   // Gyro noise qg [I; [a]x; [b]x][...]^T with [b]x [a]x^T = (a.b) I - a b^T; accel noise
   // qa [0; I; tau I][...]^T; position noise qp on the position block.
   const Matrix3d ax = qg_ * skew(sum_a);
@@ -165,9 +172,6 @@ void CovarianceWindow::add_white_noise(PaddedBlock9& a) const {
   a.block<3, 3>(kRot, kVel) -= ax;
   a.block<3, 3>(kPos, kRot) += bx;
   a.block<3, 3>(kRot, kPos) -= bx;
-  const auto saa = s.block<3, 3>(0, 0);
-  const auto sab = s.block<3, 3>(0, 3);  // sum dt a b^T
-  const auto sbb = s.block<3, 3>(3, 3);
   Matrix3d vv = -qg_ * saa;
   vv.diagonal().array() += qg_ * saa.trace() + qa_ * s0;
   a.block<3, 3>(kVel, kVel) += vv;
