@@ -20,7 +20,7 @@ constexpr double kMaxOriginDistance = 100.0;
 
 // Longest covariance window: bounds the growth of the free-fall coordinates (g t^2 / 2) and of
 // the window sums, hence their rounding, whatever the IMU rate.
-constexpr double kMaxWindowSeconds = 0.2;
+constexpr double kMaxWindowSeconds = 0.32;
 
 // Left-multiplies the rot/vel/pos row blocks of m by Ad_E for E = (e, dv, dp):
 // [[e, 0, 0], [[dv]x e, e, 0], [[dp]x e, 0, e]].

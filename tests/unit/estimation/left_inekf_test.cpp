@@ -209,7 +209,7 @@ bool identical(const NavState& a, const NavState& b) {
          a.gyro_bias == b.gyro_bias && a.accel_bias == b.accel_bias;
 }
 
-// The deferred covariance (windows of up to 20 steps, formed only when read) against the
+// The deferred covariance (windows of up to 32 steps, formed only when read) against the
 // textbook per-step propagation P <- expm(A dt) (P + Q dt) expm(A dt)^T in left-invariant
 // coordinates, and against the filter propagating at every step, over 1000 random steps
 // with random step lengths and queries at random times. Fast enough to pass the 100 m origin

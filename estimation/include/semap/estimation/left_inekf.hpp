@@ -21,7 +21,7 @@ namespace semap::estimation {
 // (see InekfImuStep). Its propagation is deferred exactly (CovarianceWindow): propagate()
 // only accumulates running sums, and the covariance is formed when a correction, a query,
 // an origin move or an inflation needs it, and at the latest every `max_window_steps` steps
-// or 0.2 s, which bounds rounding and gives a long IMU-only run its share of the cost.
+// or 0.32 s, which bounds rounding and gives a long IMU-only run its share of the cost.
 // Queries are const and cache their result without ending the window, so the filter's output
 // does not depend on who reads it when.
 // Positions in Ad_X are taken relative to an origin o kept near the robot (moved to it at
@@ -32,7 +32,7 @@ namespace semap::estimation {
 // returns the left-invariant covariance.
 class LeftInekf final : public NavFilter {
  public:
-  static constexpr int kDefaultWindowSteps = 20;
+  static constexpr int kDefaultWindowSteps = 32;
 
   // max_window_steps = 1 propagates the covariance at every step.
   explicit LeftInekf(const FilterParams& params, int max_window_steps = kDefaultWindowSteps);
