@@ -33,9 +33,11 @@ struct WorldCovariance {
 // (tau = T - t_k); for isotropic Q its gyro part is qg [I; [a]x; [b]x][I; [a]x; [b]x]^T dt with
 // a = c_k + g T, b = e_k + c_k T + g T^2 / 2 (c, e the free-fall coordinates of the step), so
 // the second moments of z_k = (c_k, e_k, 1, t_k) weighted by dt_k are all N(T) needs.
-// Per step that is a coupling sum, a rank-6 update of Y (split into the 9-row gyro and the
-// 6-row accel part) and a rank-1 update of an 8x8 moment matrix, instead of the two 10x6 by
-// 6x9 products and the shears of a per-step propagation.
+// (The white-noise part of the accel and position blocks needs sum dt, sum t_k dt and
+// sum t_k^2 dt, also in those moments.) Per step that is a coupling sum, a rank-6 update of Y
+// on its upper block triangle (the accel-bias columns of H have no rotation rows) and a rank-1
+// update of the 8x8 moments, instead of the two 12x6 by 6x9 products, the shears and the noise
+// of a per-step propagation. Noise densities must be isotropic per block (ImuNoise is).
 class CovarianceWindow {
  public:
   CovarianceWindow(const ImuNoise& noise, const Eigen::Vector3d& gravity);

@@ -23,7 +23,8 @@ namespace semap::estimation {
 // an origin move or an inflation needs it, and at the latest every `max_window_steps` steps
 // or 0.32 s, which bounds rounding and gives a long IMU-only run its share of the cost.
 // Queries are const and cache their result without ending the window, so the filter's output
-// does not depend on who reads it when.
+// does not depend on who reads it when (that cache makes concurrent const reads unsafe; the
+// filter has one owner thread, like Estimator).
 // Positions in Ad_X are taken relative to an origin o kept near the robot (moved to it at
 // every correction and after 100 m without one): with o fixed far away, [p]x terms of size
 // |p|^2 var(rot) would cancel in the left covariance and cost digits.
