@@ -1,0 +1,189 @@
+#include "plane_tile.hpp"
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+#include <algorithm>
+#include <bit>
+
+namespace semap::mapping::detail {
+
+namespace {
+
+// Floats a vector update may write past the last row of the last plane.
+constexpr std::size_t kPad = 8;
+
+#if defined(__AVX2__)
+// The polynomial kernel's coefficients, one register per power (lane = piece).
+struct KernelLanes {
+  explicit KernelLanes(const KernelPolynomial& kernel) {
+    for (int j = 0; j <= KernelPolynomial::kDegree; ++j) {
+      c[j] = _mm256_loadu_ps(kernel.coefficients()[static_cast<std::size_t>(j)].data());
+    }
+    inv_ell2 = _mm256_set1_ps(kernel.inv_ell_squared());
+  }
+  static_assert(KernelPolynomial::kPieces == 8, "one piece per lane of a permute");
+  __m256 c[KernelPolynomial::kDegree + 1];
+  __m256 inv_ell2;
+};
+
+// KernelPolynomial::operator() for 8 squared distances, 0 in lanes outside `inside`. The same
+// operations in the same order (no FMA), so the same bits as the scalar path.
+inline __m256 kernel8(__m256 d2, __m256 inside, const KernelLanes& kernel) {
+  const __m256 r = _mm256_sqrt_ps(_mm256_mul_ps(d2, kernel.inv_ell2));
+  const __m256 valid = _mm256_and_ps(inside, _mm256_cmp_ps(r, _mm256_set1_ps(1.0f), _CMP_LT_OQ));
+  const __m256 y = _mm256_mul_ps(r, _mm256_set1_ps(static_cast<float>(KernelPolynomial::kPieces)));
+  const __m256i piece = _mm256_cvttps_epi32(y);
+  const __m256 t = _mm256_sub_ps(_mm256_sub_ps(y, _mm256_cvtepi32_ps(piece)), _mm256_set1_ps(0.5f));
+  __m256 g = _mm256_permutevar8x32_ps(kernel.c[KernelPolynomial::kDegree], piece);
+  for (int j = KernelPolynomial::kDegree - 1; j >= 0; --j) {
+    g = _mm256_add_ps(_mm256_mul_ps(g, t), _mm256_permutevar8x32_ps(kernel.c[j], piece));
+  }
+  const __m256 e = _mm256_sub_ps(_mm256_set1_ps(1.0f), r);
+  const __m256 e2 = _mm256_mul_ps(e, e);
+  return _mm256_and_ps(_mm256_mul_ps(g, _mm256_mul_ps(_mm256_mul_ps(e2, e2), e)), valid);
+}
+
+#endif
+
+// The planes as locals for the hot loop: stores through float* and std::uint32_t* would
+// otherwise make the compiler reload PlaneTile's members after every row.
+struct PlaneView {
+  float* data;
+  std::size_t plane;
+  std::uint32_t* rows;
+  std::size_t side;
+  std::size_t k;
+};
+
+// PlaneTile::add for rows of at most 8 kChunks cells, labels hard or soft (`y`). Rows are
+// visited z-slice by z-slice; per slice, the rows whose centre line passes within ell are one
+// run, found without branches (at its ends rounding may leave dyz2 >= ell^2; those rows then
+// have no inside cell). Per row, x is inside when d2x < ell^2 - dyz2: again one run.
+template <int kChunks, bool kSoft>
+void add_rows(const PlaneView& planes, const CellBox& box, const std::array<const float*, 3>& d2,
+              std::int32_t label, const float* y, const KernelPolynomial& kernel) {
+  const float ell2 = kernel.ell_squared();
+  const std::int32_t width = box.hi[0] - box.lo[0] + 1;
+  const std::size_t side = planes.side;
+  // Hard labels write to their label's plane only.
+  float* const first = planes.data + static_cast<std::size_t>(box.lo[0]) +
+                       (kSoft ? 0 : static_cast<std::size_t>(label) * planes.plane);
+#if defined(__AVX2__)
+  const KernelLanes lanes(kernel);
+  // Per 8-cell chunk of the row: the distances along x and which lanes lie in the box.
+  __m256 dx[kChunks];
+  __m256 in_box[kChunks];
+  for (int c = 0; c < kChunks; ++c) {
+    dx[c] = _mm256_loadu_ps(d2[0] + 8 * c);
+    in_box[c] = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(width - 8 * c),
+                                                       _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)));
+  }
+#endif
+  for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
+    const float dz2 = d2[2][z - box.lo[2]];
+    const std::uint32_t rows_inside = inside_mask(d2[1], box.hi[1] - box.lo[1] + 1, ell2 - dz2);
+    if (rows_inside == 0) continue;
+    const std::int32_t y_first = std::countr_zero(rows_inside);
+    const std::int32_t y_last = 31 - std::countl_zero(rows_inside);
+    auto row = static_cast<std::size_t>(z) * side + static_cast<std::size_t>(box.lo[1] + y_first);
+    float* cells = first + row * side;
+    for (std::int32_t yy = y_first; yy <= y_last; ++yy, ++row, cells += side) {
+      const float dyz2 = dz2 + d2[1][yy];
+      const float rest = ell2 - dyz2;
+      std::uint32_t mask = 0;
+#if defined(__AVX2__)
+      for (int c = 0; c < kChunks; ++c) {
+        const __m256 inside =
+            _mm256_and_ps(_mm256_cmp_ps(dx[c], _mm256_set1_ps(rest), _CMP_LT_OQ), in_box[c]);
+        const auto bits = static_cast<std::uint32_t>(_mm256_movemask_ps(inside));
+        if (bits == 0) continue;
+        mask |= bits << (8 * c);
+        const __m256 w = kernel8(_mm256_add_ps(_mm256_set1_ps(dyz2), dx[c]), inside, lanes);
+        float* chunk = cells + 8 * c;
+        if constexpr (kSoft) {
+          for (std::size_t k = 0; k < planes.k; ++k) {
+            float* p = chunk + k * planes.plane;
+            _mm256_storeu_ps(
+                p, _mm256_add_ps(_mm256_loadu_ps(p), _mm256_mul_ps(w, _mm256_set1_ps(y[k]))));
+          }
+        } else {
+          _mm256_storeu_ps(chunk, _mm256_add_ps(_mm256_loadu_ps(chunk), w));
+        }
+      }
+#else
+      mask = inside_mask(d2[0], width, rest);
+      if (mask == 0) continue;
+      const std::int32_t x_hi = 31 - std::countl_zero(mask);
+      for (std::int32_t x = std::countr_zero(mask); x <= x_hi; ++x) {
+        const float w = kernel(dyz2 + d2[0][x]);
+        if constexpr (kSoft) {
+          for (std::size_t k = 0; k < planes.k; ++k) {
+            cells[k * planes.plane + static_cast<std::size_t>(x)] += w * y[k];
+          }
+        } else {
+          cells[x] += w;
+        }
+      }
+#endif
+      planes.rows[row] |= mask << box.lo[0];
+    }
+  }
+}
+
+}  // namespace
+
+PlaneTile::PlaneTile(std::int32_t side, int num_classes)
+    : side_(side),
+      k_(static_cast<std::size_t>(num_classes)),
+      plane_(static_cast<std::size_t>(side) * side * side),
+      planes_(k_ * plane_ + kPad, 0.0f),
+      rows_(static_cast<std::size_t>(side) * side, 0u) {}
+
+void PlaneTile::add(const CellBox& box, const std::array<const float*, 3>& d2, std::int32_t label,
+                    const float* y, const KernelPolynomial& kernel) {
+  const PlaneView planes{planes_.data(), plane_, rows_.data(), static_cast<std::size_t>(side_), k_};
+#if defined(__AVX2__)
+  // Rows of up to 32 cells: 8 cells (the common case, ell <= 3.5 resolutions) or 4 vectors.
+  constexpr int kWide = 4;
+  if (box.hi[0] - box.lo[0] < 8) {
+    if (label >= 0) return add_rows<1, false>(planes, box, d2, label, y, kernel);
+    return add_rows<1, true>(planes, box, d2, label, y, kernel);
+  }
+  if (label >= 0) return add_rows<kWide, false>(planes, box, d2, label, y, kernel);
+  return add_rows<kWide, true>(planes, box, d2, label, y, kernel);
+#else
+  if (label >= 0) return add_rows<1, false>(planes, box, d2, label, y, kernel);
+  return add_rows<1, true>(planes, box, d2, label, y, kernel);
+#endif
+}
+
+void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& block) {
+  const std::int32_t n = block.cells_per_side();
+  const auto side = static_cast<std::size_t>(side_);
+  const std::uint64_t low = (std::uint64_t{1} << n) - 1;
+  for (std::int32_t z = 0; z < n; ++z) {
+    for (std::int32_t y = 0; y < n; ++y) {
+      const auto row = static_cast<std::size_t>((first[2] + z) * side_ + first[1] + y);
+      const std::uint64_t bits = (std::uint64_t{rows_[row]} >> first[0]) & low;
+      if (bits == 0) continue;
+      // Only cells with a bit are non-zero, so adding and clearing the whole block row is
+      // exact and leaves the scratch zeroed.
+      float* src = planes_.data() + row * side + static_cast<std::size_t>(first[0]);
+      const int cell = block.cell_of(0, y, z);
+      float* dst = block.cell_evidence_mutable(cell);
+      for (std::int32_t x = 0; x < n; ++x) {
+        for (std::size_t k = 0; k < k_; ++k)
+          dst[k] += src[k * plane_ + static_cast<std::size_t>(x)];
+        dst += k_;
+      }
+      for (std::size_t k = 0; k < k_; ++k) std::fill_n(src + k * plane_, n, 0.0f);
+      block.mark_observed_word(cell >> 6, bits << (cell & 63));
+    }
+  }
+}
+
+void PlaneTile::clear_marks() { std::fill(rows_.begin(), rows_.end(), 0u); }
+
+}  // namespace semap::mapping::detail
