@@ -2,10 +2,13 @@
 
 #if defined(__AVX2__)
 #include <immintrin.h>
+#elif defined(__SSE2__)
+#include <xmmintrin.h>
 #endif
 
 #include <algorithm>
 #include <bit>
+#include <limits>
 
 namespace semap::mapping::detail {
 
@@ -18,33 +21,33 @@ constexpr std::size_t kPad = 8;
 // The polynomial kernel's coefficients, one register per power (lane = piece).
 struct KernelLanes {
   explicit KernelLanes(const KernelPolynomial& kernel) {
-    for (int j = 0; j <= KernelPolynomial::kDegree; ++j) {
-      c[j] = _mm256_loadu_ps(kernel.coefficients()[static_cast<std::size_t>(j)].data());
+    for (std::size_t j = 0; j <= KernelPolynomial::kDegree; ++j) {
+      c[j] = _mm256_loadu_ps(kernel.coefficients()[j].data());
     }
-    inv_ell2 = _mm256_set1_ps(kernel.inv_ell_squared());
+    scale = _mm256_set1_ps(kernel.scale());
   }
   static_assert(KernelPolynomial::kPieces == 8, "one piece per lane of a permute");
   __m256 c[KernelPolynomial::kDegree + 1];
-  __m256 inv_ell2;
+  __m256 scale;
 };
 
 // KernelPolynomial::operator() for 8 squared distances, 0 in lanes outside `inside`. The same
-// operations in the same order (no FMA), so the same bits as the scalar path.
+// operations in the same order (no FMA), so the same bits as the scalar path. Lanes with
+// y >= kPieces (rounding at the sphere's edge) get e = 0, hence k = 0, instead of a branch.
 inline __m256 kernel8(__m256 d2, __m256 inside, const KernelLanes& kernel) {
-  const __m256 r = _mm256_sqrt_ps(_mm256_mul_ps(d2, kernel.inv_ell2));
-  const __m256 valid = _mm256_and_ps(inside, _mm256_cmp_ps(r, _mm256_set1_ps(1.0f), _CMP_LT_OQ));
-  const __m256 y = _mm256_mul_ps(r, _mm256_set1_ps(static_cast<float>(KernelPolynomial::kPieces)));
+  const __m256 y = _mm256_sqrt_ps(_mm256_mul_ps(d2, kernel.scale));
   const __m256i piece = _mm256_cvttps_epi32(y);
-  const __m256 t = _mm256_sub_ps(_mm256_sub_ps(y, _mm256_cvtepi32_ps(piece)), _mm256_set1_ps(0.5f));
+  const __m256 t = _mm256_sub_ps(y, _mm256_cvtepi32_ps(piece));
   __m256 g = _mm256_permutevar8x32_ps(kernel.c[KernelPolynomial::kDegree], piece);
   for (int j = KernelPolynomial::kDegree - 1; j >= 0; --j) {
     g = _mm256_add_ps(_mm256_mul_ps(g, t), _mm256_permutevar8x32_ps(kernel.c[j], piece));
   }
-  const __m256 e = _mm256_sub_ps(_mm256_set1_ps(1.0f), r);
+  const __m256 e =
+      _mm256_max_ps(_mm256_sub_ps(_mm256_set1_ps(static_cast<float>(KernelPolynomial::kPieces)), y),
+                    _mm256_setzero_ps());
   const __m256 e2 = _mm256_mul_ps(e, e);
-  return _mm256_and_ps(_mm256_mul_ps(g, _mm256_mul_ps(_mm256_mul_ps(e2, e2), e)), valid);
+  return _mm256_and_ps(_mm256_mul_ps(g, _mm256_mul_ps(_mm256_mul_ps(e2, e2), e)), inside);
 }
-
 #endif
 
 // The planes as locals for the hot loop: stores through float* and std::uint32_t* would
@@ -72,13 +75,14 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
                        (kSoft ? 0 : static_cast<std::size_t>(label) * planes.plane);
 #if defined(__AVX2__)
   const KernelLanes lanes(kernel);
-  // Per 8-cell chunk of the row: the distances along x and which lanes lie in the box.
+  // Per 8-cell chunk of the row the distances along x, +infinity in lanes beyond the box
+  // so that they are never inside.
   __m256 dx[kChunks];
-  __m256 in_box[kChunks];
   for (int c = 0; c < kChunks; ++c) {
-    dx[c] = _mm256_loadu_ps(d2[0] + 8 * c);
-    in_box[c] = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(width - 8 * c),
-                                                       _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)));
+    const __m256 in_box = _mm256_castsi256_ps(_mm256_cmpgt_epi32(
+        _mm256_set1_epi32(width - 8 * c), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)));
+    dx[c] = _mm256_blendv_ps(_mm256_set1_ps(std::numeric_limits<float>::infinity()),
+                             _mm256_loadu_ps(d2[0] + 8 * c), in_box);
   }
 #endif
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
@@ -95,8 +99,7 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
       std::uint32_t mask = 0;
 #if defined(__AVX2__)
       for (int c = 0; c < kChunks; ++c) {
-        const __m256 inside =
-            _mm256_and_ps(_mm256_cmp_ps(dx[c], _mm256_set1_ps(rest), _CMP_LT_OQ), in_box[c]);
+        const __m256 inside = _mm256_cmp_ps(dx[c], _mm256_set1_ps(rest), _CMP_LT_OQ);
         const auto bits = static_cast<std::uint32_t>(_mm256_movemask_ps(inside));
         if (bits == 0) continue;
         mask |= bits << (8 * c);
@@ -161,7 +164,8 @@ void PlaneTile::add(const CellBox& box, const std::array<const float*, 3>& d2, s
 
 void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& block) {
   const std::int32_t n = block.cells_per_side();
-  const auto side = static_cast<std::size_t>(side_);
+  const std::size_t k = k_;
+  const std::size_t plane = plane_;
   const std::uint64_t low = (std::uint64_t{1} << n) - 1;
   for (std::int32_t z = 0; z < n; ++z) {
     for (std::int32_t y = 0; y < n; ++y) {
@@ -170,15 +174,39 @@ void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& blo
       if (bits == 0) continue;
       // Only cells with a bit are non-zero, so adding and clearing the whole block row is
       // exact and leaves the scratch zeroed.
-      float* src = planes_.data() + row * side + static_cast<std::size_t>(first[0]);
+      float* src = planes_.data() + row * static_cast<std::size_t>(side_) +
+                   static_cast<std::size_t>(first[0]);
       const int cell = block.cell_of(0, y, z);
       float* dst = block.cell_evidence_mutable(cell);
-      for (std::int32_t x = 0; x < n; ++x) {
-        for (std::size_t k = 0; k < k_; ++k)
-          dst[k] += src[k * plane_ + static_cast<std::size_t>(x)];
-        dst += k_;
+      std::size_t c = 0;
+#if defined(__SSE2__)
+      // Rows of 4 cells (blocks of depth 3): 4 classes at a time, a 4x4 transpose from
+      // planes to cells.
+      if (n == 4) {
+        for (; c + 4 <= k; c += 4) {
+          float* p = src + c * plane;
+          __m128 r0 = _mm_loadu_ps(p);
+          __m128 r1 = _mm_loadu_ps(p + plane);
+          __m128 r2 = _mm_loadu_ps(p + 2 * plane);
+          __m128 r3 = _mm_loadu_ps(p + 3 * plane);
+          _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+          float* d = dst + c;
+          _mm_storeu_ps(d, _mm_add_ps(_mm_loadu_ps(d), r0));
+          _mm_storeu_ps(d + k, _mm_add_ps(_mm_loadu_ps(d + k), r1));
+          _mm_storeu_ps(d + 2 * k, _mm_add_ps(_mm_loadu_ps(d + 2 * k), r2));
+          _mm_storeu_ps(d + 3 * k, _mm_add_ps(_mm_loadu_ps(d + 3 * k), r3));
+          for (int j = 0; j < 4; ++j)
+            _mm_storeu_ps(p + static_cast<std::size_t>(j) * plane, _mm_setzero_ps());
+        }
       }
-      for (std::size_t k = 0; k < k_; ++k) std::fill_n(src + k * plane_, n, 0.0f);
+#endif
+      for (; c < k; ++c) {
+        float* p = src + c * plane;
+        for (std::int32_t x = 0; x < n; ++x) {
+          dst[static_cast<std::size_t>(x) * k + c] += p[x];
+          p[x] = 0.0f;
+        }
+      }
       block.mark_observed_word(cell >> 6, bits << (cell & 63));
     }
   }
