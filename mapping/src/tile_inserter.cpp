@@ -291,8 +291,8 @@ void TileInserter::create_blocks(const BlockAt& block_at, TileInsertResult& resu
   }
 }
 
-TileInserter::Piece TileInserter::piece_of(std::size_t i,
-                                           const std::array<std::int32_t, 3>& base) const {
+inline TileInserter::Piece TileInserter::piece_of(std::size_t i,
+                                                  const std::array<std::int32_t, 3>& base) const {
   const std::int32_t side = 1 << tile_shift_;
   const CellBox& support = boxes_[i];
   Piece piece{};
