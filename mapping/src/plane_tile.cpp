@@ -56,20 +56,37 @@ struct PlaneView {
   float* data;
   std::size_t plane;
   std::uint32_t* rows;
+  PlaneTile::RowJob* jobs;
   std::size_t side;
+  std::int32_t side_i;
   std::size_t k;
 };
+using RowJob = PlaneTile::RowJob;
 
-// PlaneTile::add for rows of at most 8 kChunks cells, labels hard or soft (`y`). Rows are
-// visited z-slice by z-slice; per slice, the rows whose centre line passes within ell are one
-// run, found without branches (at its ends rounding may leave dyz2 >= ell^2; those rows then
-// have no inside cell). Per row, x is inside when d2x < ell^2 - dyz2: again one run.
+// PlaneTile::add for rows of at most 8 kChunks cells, labels hard or soft (`y`). First the
+// rows whose centre line passes within ell are listed (compacted without branches), then
+// each is updated in one loop: with a fixed trip count per point the loop exit is predicted,
+// where per z-slice loops of varying length mispredicted about once per slice and made the
+// long dependency chains of the kernel run one slice at a time. Per row, x is inside when
+// d2x < ell^2 - dyz2; rounding may leave a listed row without inside cells, it then adds 0.
 template <int kChunks, bool kSoft>
 void add_rows(const PlaneView& planes, const CellBox& box, const std::array<const float*, 3>& d2,
               std::int32_t label, const float* y, const KernelPolynomial& kernel) {
   const float ell2 = kernel.ell_squared();
   const std::int32_t width = box.hi[0] - box.lo[0] + 1;
+  const std::int32_t height = box.hi[1] - box.lo[1] + 1;
   const std::size_t side = planes.side;
+  RowJob* const jobs = planes.jobs;
+  std::size_t count = 0;
+  for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
+    const float dz2 = d2[2][z - box.lo[2]];
+    const float rest = ell2 - dz2;
+    const auto row = static_cast<std::uint32_t>(z * planes.side_i + box.lo[1]);
+    for (std::int32_t yy = 0; yy < height; ++yy) {
+      jobs[count] = {row + static_cast<std::uint32_t>(yy), dz2 + d2[1][yy]};
+      count += d2[1][yy] < rest ? 1 : 0;
+    }
+  }
   // Hard labels write to their label's plane only.
   float* const first = planes.data + static_cast<std::size_t>(box.lo[0]) +
                        (kSoft ? 0 : static_cast<std::size_t>(label) * planes.plane);
@@ -85,53 +102,47 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
                              _mm256_loadu_ps(d2[0] + 8 * c), in_box);
   }
 #endif
-  for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
-    const float dz2 = d2[2][z - box.lo[2]];
-    const std::uint32_t rows_inside = inside_mask(d2[1], box.hi[1] - box.lo[1] + 1, ell2 - dz2);
-    if (rows_inside == 0) continue;
-    const std::int32_t y_first = std::countr_zero(rows_inside);
-    const std::int32_t y_last = 31 - std::countl_zero(rows_inside);
-    auto row = static_cast<std::size_t>(z) * side + static_cast<std::size_t>(box.lo[1] + y_first);
+  for (std::size_t j = 0; j < count; ++j) {
+    const std::size_t row = jobs[j].row;
+    const float dyz2 = jobs[j].dyz2;
+    const float rest = ell2 - dyz2;
     float* cells = first + row * side;
-    for (std::int32_t yy = y_first; yy <= y_last; ++yy, ++row, cells += side) {
-      const float dyz2 = dz2 + d2[1][yy];
-      const float rest = ell2 - dyz2;
-      std::uint32_t mask = 0;
+    std::uint32_t mask = 0;
 #if defined(__AVX2__)
-      for (int c = 0; c < kChunks; ++c) {
-        const __m256 inside = _mm256_cmp_ps(dx[c], _mm256_set1_ps(rest), _CMP_LT_OQ);
-        const auto bits = static_cast<std::uint32_t>(_mm256_movemask_ps(inside));
-        if (bits == 0) continue;
-        mask |= bits << (8 * c);
-        const __m256 w = kernel8(_mm256_add_ps(_mm256_set1_ps(dyz2), dx[c]), inside, lanes);
-        float* chunk = cells + 8 * c;
-        if constexpr (kSoft) {
-          for (std::size_t k = 0; k < planes.k; ++k) {
-            float* p = chunk + k * planes.plane;
-            _mm256_storeu_ps(
-                p, _mm256_add_ps(_mm256_loadu_ps(p), _mm256_mul_ps(w, _mm256_set1_ps(y[k]))));
-          }
-        } else {
-          _mm256_storeu_ps(chunk, _mm256_add_ps(_mm256_loadu_ps(chunk), w));
+    for (int c = 0; c < kChunks; ++c) {
+      const __m256 inside = _mm256_cmp_ps(dx[c], _mm256_set1_ps(rest), _CMP_LT_OQ);
+      const auto bits = static_cast<std::uint32_t>(_mm256_movemask_ps(inside));
+      // Wide rows skip their empty chunks; a single chunk is updated regardless (adding 0).
+      if (kChunks > 1 && bits == 0) continue;
+      mask |= bits << (8 * c);
+      const __m256 w = kernel8(_mm256_add_ps(_mm256_set1_ps(dyz2), dx[c]), inside, lanes);
+      float* chunk = cells + 8 * c;
+      if constexpr (kSoft) {
+        for (std::size_t k = 0; k < planes.k; ++k) {
+          float* p = chunk + k * planes.plane;
+          _mm256_storeu_ps(
+              p, _mm256_add_ps(_mm256_loadu_ps(p), _mm256_mul_ps(w, _mm256_set1_ps(y[k]))));
         }
+      } else {
+        _mm256_storeu_ps(chunk, _mm256_add_ps(_mm256_loadu_ps(chunk), w));
       }
-#else
-      mask = inside_mask(d2[0], width, rest);
-      if (mask == 0) continue;
-      const std::int32_t x_hi = 31 - std::countl_zero(mask);
-      for (std::int32_t x = std::countr_zero(mask); x <= x_hi; ++x) {
-        const float w = kernel(dyz2 + d2[0][x]);
-        if constexpr (kSoft) {
-          for (std::size_t k = 0; k < planes.k; ++k) {
-            cells[k * planes.plane + static_cast<std::size_t>(x)] += w * y[k];
-          }
-        } else {
-          cells[x] += w;
-        }
-      }
-#endif
-      planes.rows[row] |= mask << box.lo[0];
     }
+#else
+    mask = inside_mask(d2[0], width, rest);
+    if (mask == 0) continue;
+    const std::int32_t x_hi = 31 - std::countl_zero(mask);
+    for (std::int32_t x = std::countr_zero(mask); x <= x_hi; ++x) {
+      const float w = kernel(dyz2 + d2[0][x]);
+      if constexpr (kSoft) {
+        for (std::size_t k = 0; k < planes.k; ++k) {
+          cells[k * planes.plane + static_cast<std::size_t>(x)] += w * y[k];
+        }
+      } else {
+        cells[x] += w;
+      }
+    }
+#endif
+    planes.rows[row] |= mask << box.lo[0];
   }
 }
 
@@ -142,11 +153,14 @@ PlaneTile::PlaneTile(std::int32_t side, int num_classes)
       k_(static_cast<std::size_t>(num_classes)),
       plane_(static_cast<std::size_t>(side) * side * side),
       planes_(k_ * plane_ + kPad, 0.0f),
-      rows_(static_cast<std::size_t>(side) * side, 0u) {}
+      rows_(static_cast<std::size_t>(side) * side, 0u),
+      jobs_(static_cast<std::size_t>(side) * side) {}
 
 void PlaneTile::add(const CellBox& box, const std::array<const float*, 3>& d2, std::int32_t label,
                     const float* y, const KernelPolynomial& kernel) {
-  const PlaneView planes{planes_.data(), plane_, rows_.data(), static_cast<std::size_t>(side_), k_};
+  const PlaneView planes{
+      planes_.data(), plane_, rows_.data(), jobs_.data(), static_cast<std::size_t>(side_),
+      side_,          k_};
 #if defined(__AVX2__)
   // Rows of up to 32 cells: 8 cells (the common case, ell <= 3.5 resolutions) or 4 vectors.
   constexpr int kWide = 4;
