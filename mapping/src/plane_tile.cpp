@@ -56,12 +56,13 @@ struct PlaneView {
   float* data;
   std::size_t plane;
   std::uint32_t* rows;
-  PlaneTile::RowJob* jobs;
+  std::uint32_t* job_rows;  // a point's rows: index in the tile,
+  float* job_dyz2;          // dy^2 + dz^2,
+  float* job_rest;          // and ell^2 - dyz2
   std::size_t side;
   std::int32_t side_i;
   std::size_t k;
 };
-using RowJob = PlaneTile::RowJob;
 
 // PlaneTile::add for rows of at most 8 kChunks cells, labels hard or soft (`y`). First the
 // rows whose centre line passes within ell are listed (compacted without branches), then
@@ -76,14 +77,35 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
   const std::int32_t width = box.hi[0] - box.lo[0] + 1;
   const std::int32_t height = box.hi[1] - box.lo[1] + 1;
   const std::size_t side = planes.side;
-  RowJob* const jobs = planes.jobs;
+  std::uint32_t* const rows = planes.job_rows;
+  float* const dyz2s = planes.job_dyz2;
+  float* const rests = planes.job_rest;
   std::size_t count = 0;
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
     const float dz2 = d2[2][z - box.lo[2]];
-    const float rest = ell2 - dz2;
     const auto row = static_cast<std::uint32_t>(z * planes.side_i + box.lo[1]);
+#if defined(__AVX2__)
+    if (height <= 8) {
+      // The listed rows are one run (dy^2 is convex): 8 entries from its first row on.
+      const std::uint32_t inside = inside_mask(d2[1], height, ell2 - dz2);
+      if (inside == 0) continue;
+      const auto y_first = static_cast<std::uint32_t>(std::countr_zero(inside));
+      const __m256 dyz2 = _mm256_add_ps(_mm256_set1_ps(dz2), _mm256_loadu_ps(d2[1] + y_first));
+      _mm256_storeu_ps(dyz2s + count, dyz2);
+      _mm256_storeu_ps(rests + count, _mm256_sub_ps(_mm256_set1_ps(ell2), dyz2));
+      _mm256_storeu_si256(
+          reinterpret_cast<__m256i*>(rows + count),
+          _mm256_add_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(row + y_first)),
+                           _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)));
+      count += static_cast<std::size_t>(std::popcount(inside));
+      continue;
+    }
+#endif
+    const float rest = ell2 - dz2;
     for (std::int32_t yy = 0; yy < height; ++yy) {
-      jobs[count] = {row + static_cast<std::uint32_t>(yy), dz2 + d2[1][yy]};
+      rows[count] = row + static_cast<std::uint32_t>(yy);
+      dyz2s[count] = dz2 + d2[1][yy];
+      rests[count] = ell2 - dyz2s[count];
       count += d2[1][yy] < rest ? 1 : 0;
     }
   }
@@ -103,19 +125,18 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
   }
 #endif
   for (std::size_t j = 0; j < count; ++j) {
-    const std::size_t row = jobs[j].row;
-    const float dyz2 = jobs[j].dyz2;
-    const float rest = ell2 - dyz2;
+    const std::size_t row = rows[j];
     float* cells = first + row * side;
     std::uint32_t mask = 0;
 #if defined(__AVX2__)
     for (int c = 0; c < kChunks; ++c) {
-      const __m256 inside = _mm256_cmp_ps(dx[c], _mm256_set1_ps(rest), _CMP_LT_OQ);
+      // Broadcasts from memory are loads, not shuffles competing with the kernel's permutes.
+      const __m256 inside = _mm256_cmp_ps(dx[c], _mm256_broadcast_ss(rests + j), _CMP_LT_OQ);
       const auto bits = static_cast<std::uint32_t>(_mm256_movemask_ps(inside));
       // Wide rows skip their empty chunks; a single chunk is updated regardless (adding 0).
       if (kChunks > 1 && bits == 0) continue;
       mask |= bits << (8 * c);
-      const __m256 w = kernel8(_mm256_add_ps(_mm256_set1_ps(dyz2), dx[c]), inside, lanes);
+      const __m256 w = kernel8(_mm256_add_ps(_mm256_broadcast_ss(dyz2s + j), dx[c]), inside, lanes);
       float* chunk = cells + 8 * c;
       if constexpr (kSoft) {
         for (std::size_t k = 0; k < planes.k; ++k) {
@@ -128,11 +149,11 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
       }
     }
 #else
-    mask = inside_mask(d2[0], width, rest);
+    mask = inside_mask(d2[0], width, rests[j]);
     if (mask == 0) continue;
     const std::int32_t x_hi = 31 - std::countl_zero(mask);
     for (std::int32_t x = std::countr_zero(mask); x <= x_hi; ++x) {
-      const float w = kernel(dyz2 + d2[0][x]);
+      const float w = kernel(dyz2s[j] + d2[0][x]);
       if constexpr (kSoft) {
         for (std::size_t k = 0; k < planes.k; ++k) {
           cells[k * planes.plane + static_cast<std::size_t>(x)] += w * y[k];
@@ -154,13 +175,22 @@ PlaneTile::PlaneTile(std::int32_t side, int num_classes)
       plane_(static_cast<std::size_t>(side) * side * side),
       planes_(k_ * plane_ + kPad, 0.0f),
       rows_(static_cast<std::size_t>(side) * side, 0u),
-      jobs_(static_cast<std::size_t>(side) * side) {}
+      // Rows of one point: at most side^2, and 8 listed at once.
+      job_rows_(static_cast<std::size_t>(side) * side + 8),
+      job_dyz2_(job_rows_.size()),
+      job_rest_(job_rows_.size()) {}
 
 void PlaneTile::add(const CellBox& box, const std::array<const float*, 3>& d2, std::int32_t label,
                     const float* y, const KernelPolynomial& kernel) {
-  const PlaneView planes{
-      planes_.data(), plane_, rows_.data(), jobs_.data(), static_cast<std::size_t>(side_),
-      side_,          k_};
+  const PlaneView planes{planes_.data(),
+                         plane_,
+                         rows_.data(),
+                         job_rows_.data(),
+                         job_dyz2_.data(),
+                         job_rest_.data(),
+                         static_cast<std::size_t>(side_),
+                         side_,
+                         k_};
 #if defined(__AVX2__)
   // Rows of up to 32 cells: 8 cells (the common case, ell <= 3.5 resolutions) or 4 vectors.
   constexpr int kWide = 4;

@@ -40,19 +40,16 @@ class PlaneTile {
   // Clears the row masks once every block of the tile has been flushed.
   void clear_marks();
 
-  // A row of a point's support to update: its index in the tile and dy^2 + dz^2.
-  struct RowJob {
-    std::uint32_t row;
-    float dyz2;
-  };
-
  private:
   std::int32_t side_;
   std::size_t k_;
   std::size_t plane_;  // floats per class plane
   std::vector<float> planes_;
   std::vector<std::uint32_t> rows_;
-  std::vector<RowJob> jobs_;  // the rows of the point being added (at most side^2)
+  // The rows of the point being added: index in the tile, dy^2 + dz^2, ell^2 - that.
+  std::vector<std::uint32_t> job_rows_;
+  std::vector<float> job_dyz2_;
+  std::vector<float> job_rest_;
 };
 
 }  // namespace semap::mapping::detail
