@@ -310,10 +310,11 @@ void TileInserter::scatter_in_place(Block& block, const std::array<std::int32_t,
                                     const KernelTable& kernel) const {
   const std::int32_t side = 1 << tile_shift_;
   const auto k = static_cast<std::size_t>(params_.num_classes);
-  const Piece piece = piece_of(i, base);
-  const CellBox& box = piece.box;
   if (params_.method == Method::kCsm) {
-    const int cell = block.cell_of(box.lo[0], box.lo[1], box.lo[2]);
+    // The support is the point's cell, inside this block.
+    const CellBox& cell_box = boxes_[i];
+    const int cell =
+        block.cell_of(cell_box.lo[0] - base[0], cell_box.lo[1] - base[1], cell_box.lo[2] - base[2]);
     float* alpha = block.cell_evidence_mutable(cell);
     if (training.labels[i] >= 0) {
       alpha[training.labels[i]] += 1.0f;
@@ -324,6 +325,8 @@ void TileInserter::scatter_in_place(Block& block, const std::array<std::int32_t,
     block.mark_observed(cell);
     return;
   }
+  const Piece piece = piece_of(i, base);
+  const CellBox& box = piece.box;
   if (training.labels[i] >= 0) {
     smooth_point<false>(block, side, box, piece.d2, training, i, kernel);
   } else {
