@@ -77,6 +77,8 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
   const std::int32_t width = box.hi[0] - box.lo[0] + 1;
   const std::int32_t height = box.hi[1] - box.lo[1] + 1;
   const std::size_t side = planes.side;
+  // A local: the stores below would otherwise make the compiler reload box.lo[0] per row.
+  const auto shift = static_cast<std::uint32_t>(box.lo[0]);
   std::uint32_t* const rows = planes.job_rows;
   float* const dyz2s = planes.job_dyz2;
   float* const rests = planes.job_rest;
@@ -163,7 +165,7 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
       }
     }
 #endif
-    planes.rows[row] |= mask << box.lo[0];
+    planes.rows[row] |= mask << shift;
   }
 }
 
