@@ -213,17 +213,22 @@ void TileInserter::group_by_tile(std::size_t count) {
                         }
                       }
                     });
-  // 3. Tiles numbered by first occurrence (parallel shards for large scans).
-  tile_grouping_.group(pair_tiles_, {});
-  const auto tile_of_pair = tile_grouping_.voxel_of();
-  tiles_.clear();
-  std::vector<std::uint32_t>& counts = fill_;
-  counts.assign(tile_grouping_.voxels(), 0);
-  for (std::size_t j = 0; j < pairs; ++j) {
-    const std::uint32_t id = tile_of_pair[j];
-    if (id == tiles_.size()) tiles_.push_back(pair_tiles_[j]);
-    ++counts[id];
+  // 3. Tiles numbered by first occurrence: scratch tiles are few (toy: 8..18 per scan), so a
+  // short list searched from the last hit beats hashing every pair; many tiles (blocks
+  // written in place, or a list that grows past kFewTiles) take parallel hash shards.
+  const bool few = tile_shift_ != block_shift_ && number_few_tiles(pairs);
+  if (!few) {
+    tile_grouping_.group(pair_tiles_, {});
+    const auto ids = tile_grouping_.voxel_of();
+    pair_tile_ids_.assign(ids.begin(), ids.end());
+    tiles_.clear();
+    for (std::size_t j = 0; j < pairs; ++j) {
+      if (pair_tile_ids_[j] == tiles_.size()) tiles_.push_back(pair_tiles_[j]);
+    }
   }
+  std::vector<std::uint32_t>& counts = fill_;
+  counts.assign(tiles_.size(), 0);
+  for (std::size_t j = 0; j < pairs; ++j) ++counts[pair_tile_ids_[j]];
   // 4. Counting sort: each tile's points in ascending order.
   tile_offsets_.assign(tiles_.size() + 1, 0);
   for (std::size_t t = 0; t < tiles_.size(); ++t) {
@@ -231,7 +236,9 @@ void TileInserter::group_by_tile(std::size_t count) {
   }
   fill_.assign(tile_offsets_.begin(), tile_offsets_.end() - 1);
   tile_points_.resize(pairs);
-  for (std::size_t j = 0; j < pairs; ++j) tile_points_[fill_[tile_of_pair[j]]++] = pair_points_[j];
+  for (std::size_t j = 0; j < pairs; ++j) {
+    tile_points_[fill_[pair_tile_ids_[j]]++] = pair_points_[j];
+  }
   // 5. Blocks of each tile that its points' supports overlap (parallel over tiles).
   if (tile_shift_ == block_shift_) {
     // A tile is one block, and every tile has a point.
@@ -240,6 +247,26 @@ void TileInserter::group_by_tile(std::size_t count) {
   }
   block_masks_.assign(tiles_.size() * mask_words_, 0);
   tbb::parallel_for(std::size_t{0}, tiles_.size(), [&](std::size_t t) { mark_blocks(t); });
+}
+
+bool TileInserter::number_few_tiles(std::size_t pairs) {
+  tiles_.clear();
+  pair_tile_ids_.resize(pairs);
+  std::uint32_t last = 0;
+  for (std::size_t j = 0; j < pairs; ++j) {
+    const BlockIndex& tile = pair_tiles_[j];
+    if (tiles_.empty() || !(tiles_[last] == tile)) {
+      std::size_t id = 0;
+      while (id < tiles_.size() && !(tiles_[id] == tile)) ++id;
+      if (id == tiles_.size()) {
+        if (id == kFewTiles) return false;
+        tiles_.push_back(tile);
+      }
+      last = static_cast<std::uint32_t>(id);
+    }
+    pair_tile_ids_[j] = last;
+  }
+  return true;
 }
 
 void TileInserter::mark_blocks(std::size_t tile) {

@@ -74,6 +74,9 @@ class TileInserter {
 
   void prepare_points(const TrainingSet& training);
   void group_by_tile(std::size_t count);
+  // Numbers the pairs' tiles by first occurrence (tiles_, pair_tile_ids_) with a linear
+  // list; false when more than kFewTiles distinct tiles appear (then nothing is numbered).
+  bool number_few_tiles(std::size_t pairs);
   void mark_blocks(std::size_t tile);
   void create_blocks(const BlockAt& block_at, TileInsertResult& result);
   void process_tile(std::size_t tile, const TrainingSet& training, const KernelTable& kernel);
@@ -97,7 +100,9 @@ class TileInserter {
   std::vector<std::uint32_t> pair_first_;  // count + 1: first (point, tile) pair of each point
   std::vector<BlockIndex> pair_tiles_;
   std::vector<std::uint32_t> pair_points_;
+  static constexpr std::size_t kFewTiles = 64;
   VoxelGrouping tile_grouping_;
+  std::vector<std::uint32_t> pair_tile_ids_;  // per pair: its tile's number
   std::vector<BlockIndex> tiles_;
   std::vector<std::uint32_t> tile_offsets_;  // tiles_.size() + 1, into tile_points_
   std::vector<std::uint32_t> tile_points_;
