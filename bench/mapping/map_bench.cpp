@@ -5,10 +5,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "semap/mapping/pcd_io.hpp"
@@ -53,12 +56,40 @@ MapParams toy_params(Method method) {
   return p;
 }
 
+// FNV-1a over every block's index, evidence and observed bits, blocks in index order: equal
+// checksums mean bit-identical maps (threads, builds, versions).
+std::uint64_t map_checksum(const SemanticMap& map) {
+  std::vector<std::pair<semap::mapping::BlockIndex, const semap::mapping::Block*>> blocks;
+  map.for_each_block(
+      [&](const semap::mapping::BlockIndex& index, const semap::mapping::Block& block) {
+        blocks.emplace_back(index, &block);
+      });
+  std::sort(blocks.begin(), blocks.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.first.x, a.first.y, a.first.z) < std::tie(b.first.x, b.first.y, b.first.z);
+  });
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  const auto mix = [&h](const void* data, std::size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+  };
+  for (const auto& [index, block] : blocks) {
+    mix(&index, sizeof(index));
+    mix(block->evidence().data(), block->evidence().size_bytes());
+    for (int c = 0; c < block->num_cells(); ++c) {
+      const unsigned char bit = block->observed(c) ? 1 : 0;
+      mix(&bit, 1);
+    }
+  }
+  return h;
+}
+
 struct ToyTiming {
   double best_total = 1e9;  // min over repetitions of the whole 12-scan insertion
   double cpu = 0;           // process CPU time of that run
   double training = 0;      // share spent building training sets in the best run
   std::size_t training_points = 0;
   semap::mapping::MapStats stats;
+  std::uint64_t checksum = 0;
 };
 
 ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, int repetitions) {
@@ -84,6 +115,7 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, int r
       t.training = training;
       t.training_points = points;
       t.stats = map.stats();
+      t.checksum = map_checksum(map);
     }
   }
   return t;
@@ -95,8 +127,8 @@ void toy_figures(int repetitions) {
       "== toy dataset (12 scans, res 0.1, K 4, depth 3, ell 0.3, sf2 10, free 0.5, "
       "ds 0.1, range 8), best of %d\n",
       repetitions);
-  std::printf("%-5s %-8s %10s %10s %10s %10s %9s %8s\n", "meth", "threads", "insert_ms", "cpu_ms",
-              "train_ms", "train_pts", "vs_ref", "B/cell");
+  std::printf("%-5s %-8s %10s %10s %10s %10s %9s %8s  %s\n", "meth", "threads", "insert_ms",
+              "cpu_ms", "train_ms", "train_pts", "vs_ref", "B/cell", "map_fnv");
   for (const Method method : {Method::kBki, Method::kCsm}) {
     for (const int threads : {1, 2}) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
@@ -104,10 +136,10 @@ void toy_figures(int repetitions) {
       const ToyTiming t = time_toy(clouds, method, repetitions);
       // Reference S-BKI: 0.38 s on one thread, 0.21 s on two (OpenMP).
       const double ref = threads == 1 ? 0.38 : 0.21;
-      std::printf("%-5s %-8d %10.2f %10.2f %10.2f %10zu %8.1fx %8.2f\n",
+      std::printf("%-5s %-8d %10.2f %10.2f %10.2f %10zu %8.1fx %8.2f  %016llx\n",
                   semap::mapping::to_string(method).c_str(), threads, t.best_total * 1e3,
                   t.cpu * 1e3, t.training * 1e3, t.training_points, ref / t.best_total,
-                  t.stats.bytes_per_cell());
+                  t.stats.bytes_per_cell(), static_cast<unsigned long long>(t.checksum));
     }
   }
 }

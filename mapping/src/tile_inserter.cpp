@@ -4,10 +4,6 @@
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -65,31 +61,12 @@ constexpr std::size_t kBlocksPerTask = 16;
 // Points per parallel chunk of the per-point preparation.
 constexpr std::size_t kPointGrain = 1024;
 
-// Adds k(d) y_i to every cell of the tile-local `box` whose centre lies within ell of
-// point i and sets their bits in the row masks. `d2[a][c]` is the squared distance along
-// axis a to the centres of local cell box.lo[a] + c (readable 8 floats past the box).
-// Hard labels touch one float per cell.
-// Bit x set when dx2[x] < rest, for x < width. With SSE2 and width <= 8 two compares of four
-// lanes; reads 8 floats from dx2 either way in that case, so callers pad the array.
-inline std::uint32_t inside_mask(const float* dx2, std::int32_t width, float rest) {
-#if defined(__SSE2__)
-  if (width <= 8) {
-    const __m128 r = _mm_set1_ps(rest);
-    const auto lo = static_cast<std::uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(dx2), r)));
-    const auto hi =
-        static_cast<std::uint32_t>(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(dx2 + 4), r)));
-    return (lo | hi << 4) & ((std::uint32_t{1} << width) - 1);
-  }
-#endif
-  std::uint32_t mask = 0;
-  for (std::int32_t x = 0; x < width; ++x) {
-    mask |= static_cast<std::uint32_t>(dx2[x] < rest) << x;
-  }
-  return mask;
-}
-
+// Adds k(d) y_i to every cell of the block-local `box` whose centre lies within ell of point
+// i and marks them observed. `d2[a][c]` is the squared distance along axis a to the centres
+// of local cell box.lo[a] + c (readable 8 floats past the box). Hard labels touch one float
+// per cell.
 template <bool kSoft>
-void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& box,
+void smooth_point(Block& block, std::int32_t side, const CellBox& box,
                   const std::array<const float*, 3>& d2, const TrainingSet& training, std::size_t i,
                   const KernelTable& kernel) {
   const auto k = static_cast<std::size_t>(training.num_classes);
@@ -110,7 +87,8 @@ void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& bo
     const std::int32_t y_first = std::countr_zero(rows_inside);
     const std::int32_t y_last = 31 - std::countl_zero(rows_inside);
     const std::size_t first_row = static_cast<std::size_t>(z * side + box.lo[1]);
-    float* cells = target.evidence + (first_row * side + static_cast<std::size_t>(box.lo[0])) * k +
+    float* cells = block.cell_evidence_mutable(0) +
+                   (first_row * side + static_cast<std::size_t>(box.lo[0])) * k +
                    static_cast<std::size_t>(y_first) * row_stride;
     for (std::int32_t yy = y_first; yy <= y_last; ++yy, cells += row_stride) {
       const float dyz2 = dz2 + d2[1][yy];
@@ -136,7 +114,10 @@ void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& bo
           column[static_cast<std::size_t>(x) * k] += lut.clamped(dyz2 + dx2[x]) * inside;
         }
       }
-      target.mark(first_row + static_cast<std::size_t>(yy), mask << box.lo[0], side);
+      // A row of side <= 32 cells starts at a multiple of side, so it lies in one 64-bit word.
+      const std::size_t cell = (first_row + static_cast<std::size_t>(yy)) * side;
+      block.mark_observed_word(static_cast<int>(cell >> 6),
+                               std::uint64_t{mask << box.lo[0]} << (cell & 63));
     }
   }
 }
@@ -145,6 +126,7 @@ void smooth_point(const TileTarget& target, std::int32_t side, const CellBox& bo
 
 TileInserter::TileInserter(const MapParams& params)
     : params_(params),
+      polynomial_(SparseKernel(params.sf2, params.ell)),
       block_shift_(params.block_depth - 1),
       tile_shift_(tile_shift_for(params)),
       blocks_per_tile_side_(1 << (tile_shift_ - block_shift_)),
@@ -154,7 +136,8 @@ TileInserter::TileInserter(const MapParams& params)
                   64),
       width_(params.method == Method::kCsm
                  ? 0
-                 : static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 3) {}
+                 : static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 3),
+      scratch_(std::int32_t{1} << tile_shift_, params.num_classes) {}
 
 void TileInserter::prepare_points(const TrainingSet& training) {
   const std::size_t count = training.size();
@@ -230,17 +213,22 @@ void TileInserter::group_by_tile(std::size_t count) {
                         }
                       }
                     });
-  // 3. Tiles numbered by first occurrence (parallel shards for large scans).
-  tile_grouping_.group(pair_tiles_, {});
-  const auto tile_of_pair = tile_grouping_.voxel_of();
-  tiles_.clear();
-  std::vector<std::uint32_t>& counts = fill_;
-  counts.assign(tile_grouping_.voxels(), 0);
-  for (std::size_t j = 0; j < pairs; ++j) {
-    const std::uint32_t id = tile_of_pair[j];
-    if (id == tiles_.size()) tiles_.push_back(pair_tiles_[j]);
-    ++counts[id];
+  // 3. Tiles numbered by first occurrence: scratch tiles are few (toy: 8..18 per scan), so a
+  // short list searched from the last hit beats hashing every pair; many tiles (blocks
+  // written in place, or a list that grows past kFewTiles) take parallel hash shards.
+  const bool few = tile_shift_ != block_shift_ && number_few_tiles(pairs);
+  if (!few) {
+    tile_grouping_.group(pair_tiles_, {});
+    const auto ids = tile_grouping_.voxel_of();
+    pair_tile_ids_.assign(ids.begin(), ids.end());
+    tiles_.clear();
+    for (std::size_t j = 0; j < pairs; ++j) {
+      if (pair_tile_ids_[j] == tiles_.size()) tiles_.push_back(pair_tiles_[j]);
+    }
   }
+  std::vector<std::uint32_t>& counts = fill_;
+  counts.assign(tiles_.size(), 0);
+  for (std::size_t j = 0; j < pairs; ++j) ++counts[pair_tile_ids_[j]];
   // 4. Counting sort: each tile's points in ascending order.
   tile_offsets_.assign(tiles_.size() + 1, 0);
   for (std::size_t t = 0; t < tiles_.size(); ++t) {
@@ -248,7 +236,9 @@ void TileInserter::group_by_tile(std::size_t count) {
   }
   fill_.assign(tile_offsets_.begin(), tile_offsets_.end() - 1);
   tile_points_.resize(pairs);
-  for (std::size_t j = 0; j < pairs; ++j) tile_points_[fill_[tile_of_pair[j]]++] = pair_points_[j];
+  for (std::size_t j = 0; j < pairs; ++j) {
+    tile_points_[fill_[pair_tile_ids_[j]]++] = pair_points_[j];
+  }
   // 5. Blocks of each tile that its points' supports overlap (parallel over tiles).
   if (tile_shift_ == block_shift_) {
     // A tile is one block, and every tile has a point.
@@ -257,6 +247,26 @@ void TileInserter::group_by_tile(std::size_t count) {
   }
   block_masks_.assign(tiles_.size() * mask_words_, 0);
   tbb::parallel_for(std::size_t{0}, tiles_.size(), [&](std::size_t t) { mark_blocks(t); });
+}
+
+bool TileInserter::number_few_tiles(std::size_t pairs) {
+  tiles_.clear();
+  pair_tile_ids_.resize(pairs);
+  std::uint32_t last = 0;
+  for (std::size_t j = 0; j < pairs; ++j) {
+    const BlockIndex& tile = pair_tiles_[j];
+    if (tiles_.empty() || !(tiles_[last] == tile)) {
+      std::size_t id = 0;
+      while (id < tiles_.size() && !(tiles_[id] == tile)) ++id;
+      if (id == tiles_.size()) {
+        if (id == kFewTiles) return false;
+        tiles_.push_back(tile);
+      }
+      last = static_cast<std::uint32_t>(id);
+    }
+    pair_tile_ids_[j] = last;
+  }
+  return true;
 }
 
 void TileInserter::mark_blocks(std::size_t tile) {
@@ -308,94 +318,81 @@ void TileInserter::create_blocks(const BlockAt& block_at, TileInsertResult& resu
   }
 }
 
-void TileInserter::scatter_point(const TileTarget& target, const std::array<std::int32_t, 3>& base,
-                                 std::size_t i, const TrainingSet& training,
-                                 const KernelTable& kernel) const {
+inline TileInserter::Piece TileInserter::piece_of(std::size_t i,
+                                                  const std::array<std::int32_t, 3>& base) const {
+  const std::int32_t side = 1 << tile_shift_;
+  const CellBox& support = boxes_[i];
+  Piece piece{};
+  const float* first = distances_.data() + i * 3 * width_;
+  for (int a = 0; a < 3; ++a) {
+    piece.box.lo[a] = std::max(support.lo[a], base[a]) - base[a];
+    piece.box.hi[a] = std::min(support.hi[a], base[a] + side - 1) - base[a];
+    piece.d2[a] = first + a * width_ + (base[a] + piece.box.lo[a] - support.lo[a]);
+  }
+  return piece;
+}
+
+void TileInserter::scatter_in_place(Block& block, const std::array<std::int32_t, 3>& base,
+                                    std::size_t i, const TrainingSet& training,
+                                    const KernelTable& kernel) const {
   const std::int32_t side = 1 << tile_shift_;
   const auto k = static_cast<std::size_t>(params_.num_classes);
-  const CellBox& support = boxes_[i];
-  CellBox box{};
-  for (int a = 0; a < 3; ++a) {
-    box.lo[a] = std::max(support.lo[a], base[a]) - base[a];
-    box.hi[a] = std::min(support.hi[a], base[a] + side - 1) - base[a];
-  }
   if (params_.method == Method::kCsm) {
-    const std::size_t row = static_cast<std::size_t>(box.lo[2] * side + box.lo[1]);
-    float* alpha = target.evidence + (row * side + box.lo[0]) * k;
+    // The support is the point's cell, inside this block.
+    const CellBox& cell_box = boxes_[i];
+    const int cell =
+        block.cell_of(cell_box.lo[0] - base[0], cell_box.lo[1] - base[1], cell_box.lo[2] - base[2]);
+    float* alpha = block.cell_evidence_mutable(cell);
     if (training.labels[i] >= 0) {
       alpha[training.labels[i]] += 1.0f;
     } else {
       const float* y = training.probabilities.data() + i * k;
       for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
     }
-    target.mark(row, std::uint32_t{1} << box.lo[0], side);
+    block.mark_observed(cell);
     return;
   }
-  const float* first = distances_.data() + i * 3 * width_;
-  std::array<const float*, 3> d2{};
-  for (int a = 0; a < 3; ++a) d2[a] = first + a * width_ + (base[a] + box.lo[a] - support.lo[a]);
+  const Piece piece = piece_of(i, base);
+  const CellBox& box = piece.box;
   if (training.labels[i] >= 0) {
-    smooth_point<false>(target, side, box, d2, training, i, kernel);
+    smooth_point<false>(block, side, box, piece.d2, training, i, kernel);
   } else {
-    smooth_point<true>(target, side, box, d2, training, i, kernel);
+    smooth_point<true>(block, side, box, piece.d2, training, i, kernel);
   }
 }
 
-void TileInserter::write_back(Scratch& scratch, std::size_t tile) const {
-  const std::int32_t side = 1 << tile_shift_;
+void TileInserter::write_back(PlaneTile& scratch, std::size_t tile) const {
   const std::int32_t n = 1 << block_shift_;
   const std::int32_t t_side = blocks_per_tile_side_;
-  const auto k = static_cast<std::size_t>(params_.num_classes);
-  const std::size_t row_floats = static_cast<std::size_t>(n) * k;
-  const std::uint64_t low = (std::uint64_t{1} << n) - 1;
   for (std::uint32_t j = block_offsets_[tile]; j < block_offsets_[tile + 1]; ++j) {
     const auto local = static_cast<std::int32_t>(tile_blocks_[j].local);
-    Block& block = *tile_blocks_[j].block;
-    const std::int32_t x0 = (local % t_side) * n;
-    const std::int32_t y0 = ((local / t_side) % t_side) * n;
-    const std::int32_t z0 = (local / (t_side * t_side)) * n;
-    for (std::int32_t z = 0; z < n; ++z) {
-      for (std::int32_t y = 0; y < n; ++y) {
-        const auto row = static_cast<std::size_t>((z0 + z) * side + y0 + y);
-        const std::uint64_t bits = (std::uint64_t{scratch.rows[row]} >> x0) & low;
-        if (bits == 0) continue;
-        // Only cells with a bit are non-zero, so adding and clearing the whole block row
-        // is exact and leaves the scratch zeroed.
-        float* src = scratch.evidence.data() + (row * side + x0) * k;
-        const int cell = block.cell_of(0, y, z);
-        float* dst = block.cell_evidence_mutable(cell);
-        for (std::size_t f = 0; f < row_floats; ++f) dst[f] += src[f];
-        std::memset(src, 0, row_floats * sizeof(float));
-        block.mark_observed_word(cell >> 6, bits << (cell & 63));
-      }
-    }
+    scratch.flush_block(
+        {(local % t_side) * n, ((local / t_side) % t_side) * n, (local / (t_side * t_side)) * n},
+        *tile_blocks_[j].block);
   }
-  std::fill(scratch.rows.begin(), scratch.rows.end(), 0u);
+  scratch.clear_marks();
 }
 
 void TileInserter::process_tile(std::size_t tile, const TrainingSet& training,
                                 const KernelTable& kernel) {
-  const std::int32_t side = 1 << tile_shift_;
   const std::array<std::int32_t, 3> base{
       tiles_[tile].x << tile_shift_, tiles_[tile].y << tile_shift_, tiles_[tile].z << tile_shift_};
   if (tile_shift_ == block_shift_) {
     // The tile is one block: write into it directly, in the same order as the scratch would.
-    Block* block = tile_blocks_[block_offsets_[tile]].block;
-    const TileTarget target{block->cell_evidence_mutable(0), nullptr, block};
+    Block& block = *tile_blocks_[block_offsets_[tile]].block;
     for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
-      scatter_point(target, base, tile_points_[p], training, kernel);
+      scatter_in_place(block, base, tile_points_[p], training, kernel);
     }
     return;
   }
-  Scratch& scratch = scratch_.local();
-  if (scratch.rows.empty()) {
-    const auto cells = static_cast<std::size_t>(side) * side * side;
-    scratch.evidence.assign(cells * static_cast<std::size_t>(params_.num_classes), 0.0f);
-    scratch.rows.assign(static_cast<std::size_t>(side) * side, 0u);
-  }
-  const TileTarget target{scratch.evidence.data(), scratch.rows.data(), nullptr};
+  const auto k = static_cast<std::size_t>(params_.num_classes);
+  PlaneTile& scratch = scratch_.local();
   for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
-    scatter_point(target, base, tile_points_[p], training, kernel);
+    const std::uint32_t i = tile_points_[p];
+    const Piece piece = piece_of(i, base);
+    const std::int32_t label = training.labels[i];
+    scratch.add(piece.box, piece.d2, label,
+                label >= 0 ? nullptr : training.probabilities.data() + i * k, polynomial_);
   }
   write_back(scratch, tile);
 }

@@ -12,11 +12,13 @@
 #include <vector>
 
 #include "fast_floor.hpp"
+#include "plane_tile.hpp"
 #include "semap/mapping/block.hpp"
 #include "semap/mapping/block_index.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/training_data.hpp"
+#include "support_box.hpp"
 #include "voxel_grouping.hpp"
 
 namespace semap::mapping::detail {
@@ -27,31 +29,6 @@ inline bool mappable(const Eigen::Vector3f& p, float inv_res) {
   constexpr float kLimit = static_cast<float>(1 << 20) - 64.0f;
   return p.allFinite() && (p.cwiseAbs() * inv_res).maxCoeff() < kLimit;
 }
-
-// Inclusive range of cell coordinates per axis; empty when lo > hi.
-struct CellBox {
-  std::array<std::int32_t, 3> lo;
-  std::array<std::int32_t, 3> hi;
-};
-
-// Where a tile's weights go: cell-major evidence of side^3 cells (cell (z side + y) side + x)
-// and the observed bits of each row of side cells, either as row masks of the scratch tile or,
-// when the tile is one block, as the block's own bits.
-struct TileTarget {
-  float* evidence;
-  std::uint32_t* rows;  // scratch row masks, or nullptr to mark `block`
-  Block* block;
-
-  void mark(std::size_t row, std::uint32_t bits, std::int32_t side) const {
-    if (rows != nullptr) {
-      rows[row] |= bits;
-    } else {
-      // A row of n <= 32 cells starts at a multiple of n, so it lies in one 64-bit word.
-      const std::size_t cell = row * static_cast<std::size_t>(side);
-      block->mark_observed_word(static_cast<int>(cell >> 6), std::uint64_t{bits} << (cell & 63));
-    }
-  }
-};
 
 // What one insert touched, filled by TileInserter::insert.
 struct TileInsertResult {
@@ -64,7 +41,7 @@ struct TileInsertResult {
 // more cells per side, and for S-CSM. A toy training point's support (6 cells wide) reaches
 // about 1.6 tiles of 32 instead of about 11 blocks of 4 cells, so the per-(point, piece)
 // clipping runs far less often, and the scatter loop writes into a dense per-thread scratch
-// tile (same cell-major layout as a block) instead of finding the block of every row.
+// tile (a PlaneTile, one plane per class) instead of finding the block of every row.
 //
 // Every tile is processed by one task that visits its points in input order. With a scratch
 // tile it adds their weights into the zeroed scratch, then adds the scratch to the tile's
@@ -83,12 +60,11 @@ class TileInserter {
                           const BlockAt& block_at);
 
  private:
-  // Per-thread scratch of one tile: tile_side^3 cells of K floats, and one bit mask per
-  // row of tile_side cells saying which cells got a weight (they are the observed ones and
-  // the only non-zero scratch cells).
-  struct Scratch {
-    std::vector<float> evidence;
-    std::vector<std::uint32_t> rows;
+  // A point's support clipped to a tile, in tile-local cells, and its squared per-axis
+  // distances from the clipped box's first cell on.
+  struct Piece {
+    CellBox box;
+    std::array<const float*, 3> d2;
   };
   // A block of a tile: its position inside the tile (x fastest) and the block itself.
   struct TileBlock {
@@ -98,16 +74,21 @@ class TileInserter {
 
   void prepare_points(const TrainingSet& training);
   void group_by_tile(std::size_t count);
+  // Numbers the pairs' tiles by first occurrence (tiles_, pair_tile_ids_) with a linear
+  // list; false when more than kFewTiles distinct tiles appear (then nothing is numbered).
+  bool number_few_tiles(std::size_t pairs);
   void mark_blocks(std::size_t tile);
   void create_blocks(const BlockAt& block_at, TileInsertResult& result);
   void process_tile(std::size_t tile, const TrainingSet& training, const KernelTable& kernel);
-  void scatter_point(const TileTarget& target, const std::array<std::int32_t, 3>& base,
-                     std::size_t i, const TrainingSet& training, const KernelTable& kernel) const;
-  void write_back(Scratch& scratch, std::size_t tile) const;
+  Piece piece_of(std::size_t i, const std::array<std::int32_t, 3>& base) const;
+  void scatter_in_place(Block& block, const std::array<std::int32_t, 3>& base, std::size_t i,
+                        const TrainingSet& training, const KernelTable& kernel) const;
+  void write_back(PlaneTile& scratch, std::size_t tile) const;
 
   MapParams params_;
-  std::int32_t block_shift_;  // log2(cells per block side)
-  std::int32_t tile_shift_;   // log2(cells per tile side)
+  KernelPolynomial polynomial_;  // the kernel of scratch tiles (blocks written in place: table)
+  std::int32_t block_shift_;     // log2(cells per block side)
+  std::int32_t tile_shift_;      // log2(cells per tile side)
   std::int32_t blocks_per_tile_side_;
   std::size_t mask_words_;  // 64-bit words of a tile's block mask
   std::size_t width_;       // distances stored per point and axis
@@ -119,7 +100,9 @@ class TileInserter {
   std::vector<std::uint32_t> pair_first_;  // count + 1: first (point, tile) pair of each point
   std::vector<BlockIndex> pair_tiles_;
   std::vector<std::uint32_t> pair_points_;
+  static constexpr std::size_t kFewTiles = 64;
   VoxelGrouping tile_grouping_;
+  std::vector<std::uint32_t> pair_tile_ids_;  // per pair: its tile's number
   std::vector<BlockIndex> tiles_;
   std::vector<std::uint32_t> tile_offsets_;  // tiles_.size() + 1, into tile_points_
   std::vector<std::uint32_t> tile_points_;
@@ -127,8 +110,8 @@ class TileInserter {
   std::vector<std::uint32_t> fill_;
   std::vector<std::uint32_t> block_offsets_;  // tiles_.size() + 1, into tile_blocks_
   std::vector<TileBlock> tile_blocks_;
-  std::vector<std::uint32_t> order_;  // tiles in processing order
-  tbb::enumerable_thread_specific<Scratch> scratch_;
+  std::vector<std::uint32_t> order_;                    // tiles in processing order
+  tbb::enumerable_thread_specific<PlaneTile> scratch_;  // created on first use per thread
 };
 
 }  // namespace semap::mapping::detail

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -31,6 +32,29 @@ TEST(KernelTable, AgreesWithTheExactKernel) {
   }
   EXPECT_EQ(table(0.09f), 0.0f);
   EXPECT_EQ(table(1e9f), 0.0f);
+}
+
+TEST(KernelPolynomial, AgreesWithTheExactKernelAndVanishesAtEll) {
+  for (const float ell : {0.3f, 0.5f, 1.7f}) {
+    const SparseKernel exact(10.0f, ell);
+    const KernelPolynomial poly(exact);
+    double worst = 0.0;
+    for (int i = 0; i <= 100000; ++i) {
+      const double d = 1.05 * ell * i / 100000.0;
+      const float value = poly(static_cast<float>(d * d));
+      worst = std::max(worst, std::abs(value - exact(d)));
+      // Positive inside the support (observed cells get evidence), 0 beyond.
+      if (d < 0.999 * ell) {
+        ASSERT_GT(value, 0.0f) << "d = " << d;
+      } else {
+        ASSERT_GE(value, 0.0f) << "d = " << d;
+      }
+    }
+    EXPECT_LT(worst, 1e-6 * 10.0) << "ell = " << ell;
+    EXPECT_EQ(poly(ell * ell), 0.0f);
+    EXPECT_EQ(poly(1e9f), 0.0f);
+    EXPECT_NEAR(poly(0.0f), 10.0f, 1e-6 * 10.0);
+  }
 }
 
 TEST(SparseKernel, RejectsNonPositiveParameters) {
