@@ -16,12 +16,14 @@
 #include <iostream>
 #include <memory>
 #include <random>
+#include <span>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <unordered_map>
 #include <vector>
 
+#include "semap/dds_idl/block_cdr.hpp"
 #include "semap/dds_idl/block_codec.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
@@ -101,26 +103,25 @@ int run_reader(int domain, const std::string& ns, bool latency) {
   std::vector<double> latencies_us;
   const sd::BlockLimits limits;
   std::unordered_map<sd::BlockIndex, sd::BlockSnapshot, sd::BlockIndexHash> map;
+  sd::BlockSnapshot scratch;
   for (;;) {
     const bool got = reader.wait(std::chrono::milliseconds(n == 0 ? 20000 : 1500));
     if (!got) break;
-    reader.take_each([&](const sd::msg::SemanticMapBlock& m, const dds_sample_info_t&) {
+    reader.take_each_cdr([&](std::span<const std::uint8_t> cdr, const dds_sample_info_t&) {
       const Stamp now = Stamp::now();
-      // Validation and copy into the block's map entry as the MapClient does them, so the
-      // figure is our stack's.
-      if (sd::check_block(m, limits).ok()) {
-        sd::copy_block(m, map[sd::BlockIndex{m.ix_, m.iy_, m.iz_}]);
+      // Read from the serialised bytes, checked, and swapped into the block's map entry as the
+      // MapClient does it, so the figure is our stack's.
+      Stamp stamp;
+      if (sd::read_block_cdr(cdr, scratch, stamp).ok() && sd::check_block(scratch, limits).ok()) {
+        std::swap(map[scratch.index], scratch);
       } else {
         ++bad;
       }
       if (n == 0) first = Clock::now();
       last = Clock::now();
       ++n;
-      bytes += block_bytes(m.block_cells_);
-      if (latency) {
-        latencies_us.push_back(
-            static_cast<double>(now.ns - sd::from_msg_time(m.header_.stamp_).ns) * 1e-3);
-      }
+      bytes += cdr.size() - 4;  // without the encapsulation header, as block_bytes counts
+      if (latency) latencies_us.push_back(static_cast<double>(now.ns - stamp.ns) * 1e-3);
     });
   }
   const double secs = std::chrono::duration<double>(last - first).count();
