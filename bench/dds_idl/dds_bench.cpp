@@ -2,7 +2,8 @@
 // Prints blocks/s and MB/s at two block sizes, publish-to-receive latency p50/p99 at 10 Hz map
 // updates, and ddsperf's rate for the same payload sizes in the same run.
 //   dds_bench [seconds [repetitions]]   (default 3 s a throughput run, median of 3)
-//   dds_bench --throughput CELLS SECONDS  (one throughput run of ours only: for profiling)
+//   dds_bench --throughput CELLS SECONDS [RATE]  (one run of ours only, for profiling; RATE
+//   blocks/s paces the writer, default: as fast as it goes)
 // The reader is this binary again (`dds_bench --reader ...`). CYCLONEDDS_URI defaults to the
 // loopback XML of the source tree, so nothing leaves 127.0.0.1.
 #include <sys/resource.h>
@@ -175,6 +176,7 @@ struct Throughput {
   double written_per_s = 0;
   double writer_cpu_us = 0;  // writer process CPU time per written block
   double reader_cpu_us = 0;  // reader process CPU time per received block
+  std::uint64_t written = 0;
   std::uint64_t received = 0;
   std::uint64_t bad = 0;
   std::uint64_t write_timeouts = 0;  // writes that waited max_blocking_time for the reader
@@ -185,7 +187,11 @@ struct Throughput {
   std::int64_t writer_involuntary_switches = 0;
 };
 
-Throughput throughput(int domain, std::uint16_t cells, double seconds) {
+// One throughput run. rate 0: the writer goes as fast as it can (saturating: with keep-last 1
+// the reader takes only the latest version of a block, so versions it was too slow for are
+// received by its DDS threads and then replaced unseen). rate > 0: the writer is paced to
+// `rate` blocks/s in rounds of 1000, to find the rate the reader takes in full.
+Throughput throughput(int domain, std::uint16_t cells, double seconds, double rate = 0.0) {
   const std::string ns = "bench_tp" + std::to_string(cells);
   Pipe reader(self_path() + " --reader " + std::to_string(domain) + " " + ns + " 0");
   sd::Participant p(domain);
@@ -215,6 +221,11 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
       pub.update(b);
     }
     written += pub.publish_changed(Stamp::now());
+    if (rate > 0.0) {
+      std::this_thread::sleep_until(
+          start + std::chrono::duration_cast<Clock::duration>(
+                      std::chrono::duration<double>(static_cast<double>(written) / rate)));
+    }
   }
   const double wsecs = std::chrono::duration<double>(Clock::now() - start).count();
   const double wcpu = cpu_seconds() - cpu0;
@@ -226,6 +237,7 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
   double secs = 0, rcpu = 0;
   r >> n >> bytes >> secs >> bad >> rcpu;
   Throughput t;
+  t.written = written;
   t.received = n;
   t.bad = bad;
   t.blocks_per_s = secs > 0 ? static_cast<double>(n) / secs : 0;
@@ -238,6 +250,34 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
   t.writer_cpu_us = written > 0 ? 1e6 * wcpu / static_cast<double>(written) : 0;
   t.reader_cpu_us = n > 0 ? 1e6 * rcpu / static_cast<double>(n) : 0;
   return t;
+}
+
+// Paced runs at fractions of ddsperf's default rate: the highest whose blocks the reader takes
+// in full (at least 99 % of those written) is the figure to set against ddsperf's default,
+// whose keep-all writer is held to its reader's pace by flow control, so that every sample it
+// sends is taken. The saturating figure instead counts only the versions the reader got to
+// before newer ones replaced them. Each step is printed: on a shared machine a stall of the
+// reader longer than one round (1000 blocks) loses versions at any rate.
+struct Matched {
+  double blocks_per_s = 0;
+  double reader_cpu_us = 0;
+  double writer_cpu_us = 0;
+};
+
+Matched matched_rate(int domain, std::uint16_t cells, double seconds, double ddsperf_default) {
+  Matched best;
+  std::printf("  paced writer, %% of ddsperf default -> received/written:");
+  for (double fraction : {0.25, 0.35, 0.5, 0.6, 0.75}) {
+    const Throughput t = throughput(domain, cells, seconds, fraction * ddsperf_default);
+    const double taken = t.written > 0 ? static_cast<double>(t.received) / t.written : 0.0;
+    std::printf(" %.0f%% -> %.1f%%", 100.0 * fraction, 100.0 * taken);
+    std::fflush(stdout);
+    if (taken >= 0.99 && t.blocks_per_s > best.blocks_per_s) {
+      best = {t.blocks_per_s, t.reader_cpu_us, t.writer_cpu_us};
+    }
+  }
+  std::printf("\n");
+  return best;
 }
 
 struct Latency {
@@ -311,9 +351,10 @@ int main(int argc, char** argv) {
     }
     std::random_device rd;
     const int domain = 1 + static_cast<int>(rd() % 200);
-    if (argc == 4 && std::strcmp(argv[1], "--throughput") == 0) {
+    if ((argc == 4 || argc == 5) && std::strcmp(argv[1], "--throughput") == 0) {
       const auto cells = static_cast<std::uint16_t>(std::atoi(argv[2]));
-      const Throughput t = throughput(domain, cells, std::atof(argv[3]));
+      const double rate = argc == 5 ? std::atof(argv[4]) : 0.0;
+      const Throughput t = throughput(domain, cells, std::atof(argv[3]), rate);
       std::printf("%u^3 cells: written %.0f/s received %.0f/s (%llu blocks, %llu invalid)\n", cells,
                   t.written_per_s, t.blocks_per_s, static_cast<unsigned long long>(t.received),
                   static_cast<unsigned long long>(t.bad));
@@ -363,6 +404,13 @@ int main(int argc, char** argv) {
                   r1 > 0 ? 100.0 * o / r1 : 0.0, bad ? " (INVALID BLOCKS RECEIVED)" : "");
       std::printf("  CPU per block (all threads): writer %.1f us, reader %.1f us\n", median(wcpu),
                   median(rcpu));
+      std::fflush(stdout);
+      const Matched m = matched_rate(domain, cells, seconds, r);
+      std::printf(
+          "  matched rate (writer paced, >= 99 %% taken): %.0f blocks/s, %.0f%% of ddsperf"
+          " default; CPU per block writer %.1f us, reader %.1f us\n",
+          m.blocks_per_s, r > 0 ? 100.0 * m.blocks_per_s / r : 0.0, m.writer_cpu_us,
+          m.reader_cpu_us);
       std::fflush(stdout);
     }
     for (int per_update : {10, 100}) {
