@@ -16,9 +16,13 @@ namespace semap::dds_idl {
 template <typename T>
 class Reader {
  public:
-  Reader(const Participant& participant, const Topic<T>& topic, const Qos& qos)
+  // `listener` (optional, copied by Cyclone) runs its callbacks on Cyclone's threads: with
+  // on_data_available, the receive thread takes the samples as they arrive, as ddsperf's
+  // subscriber does, instead of waking a thread of the application.
+  Reader(const Participant& participant, const Topic<T>& topic, const Qos& qos,
+         const dds_listener_t* listener = nullptr)
       : topic_name_(topic.name()),
-        entity_(check(dds_create_reader(participant.handle(), topic.handle(), qos.get(), nullptr),
+        entity_(check(dds_create_reader(participant.handle(), topic.handle(), qos.get(), listener),
                       "dds_create_reader " + topic.name())),
         condition_(check(dds_create_readcondition(entity_.handle(), DDS_ANY_STATE),
                          "dds_create_readcondition")),
