@@ -2,12 +2,15 @@
 // Prints blocks/s and MB/s at two block sizes, publish-to-receive latency p50/p99 at 10 Hz map
 // updates, and ddsperf's rate for the same payload sizes in the same run.
 //   dds_bench [seconds [repetitions]]   (default 3 s a throughput run, median of 3)
-//   dds_bench --throughput CELLS SECONDS  (one throughput run of ours only: for profiling)
-// The reader is this binary again (`dds_bench --reader ...`). CYCLONEDDS_URI defaults to the
-// loopback XML of the source tree, so nothing leaves 127.0.0.1.
+//   dds_bench --throughput CELLS SECONDS [RATE [listener|waitset]]  (one run of ours only, for
+//   profiling; RATE blocks/s paces the writer, 0 (default): as fast as it goes; the reader
+//   takes in a waitset thread unless `listener`)
+// The reader is this binary again (`dds_bench --reader ... listener|waitset`). CYCLONEDDS_URI
+// defaults to the loopback XML of the source tree, so nothing leaves 127.0.0.1.
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -15,13 +18,16 @@
 #include <ctime>
 #include <iostream>
 #include <memory>
+#include <mutex>
 #include <random>
+#include <span>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <unordered_map>
 #include <vector>
 
+#include "semap/dds_idl/block_cdr.hpp"
 #include "semap/dds_idl/block_codec.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
@@ -89,52 +95,92 @@ struct Pipe {
 
 // ---- reader side (child process) ----
 
-int run_reader(int domain, const std::string& ns, bool latency) {
+// What the reader does with each block: read from the serialised bytes, checked, and swapped
+// into the block's map entry as the MapClient does it, so the figure is our stack's.
+struct BlockSink {
+  std::uint64_t n = 0, bad = 0, bytes = 0;
+  Clock::time_point first, last;
+  bool latency = false;
+  std::vector<double> latencies_us;
+  sd::BlockLimits limits;
+  std::unordered_map<sd::BlockIndex, sd::BlockSnapshot, sd::BlockIndexHash> map;
+  sd::BlockSnapshot scratch;
+
+  void operator()(std::span<const std::uint8_t> cdr, const dds_sample_info_t&) {
+    const Stamp now = Stamp::now();
+    Stamp stamp;
+    if (sd::read_block_cdr(cdr, scratch, stamp).ok() && sd::check_block(scratch, limits).ok()) {
+      std::swap(map[scratch.index], scratch);
+    } else {
+      ++bad;
+    }
+    if (n == 0) first = Clock::now();
+    last = Clock::now();
+    ++n;
+    bytes += cdr.size() - 4;  // without the encapsulation header, as block_bytes counts
+    if (latency) latencies_us.push_back(static_cast<double>(now.ns - stamp.ns) * 1e-3);
+  }
+};
+
+using BlockReader = sd::Reader<sd::msg::SemanticMapBlock>;
+
+// Listener mode: Cyclone's receive thread takes each sample as it arrives (ddsperf's default
+// subscriber mode); the main thread only watches for the end.
+struct ListenerState {
+  std::mutex mutex;
+  std::atomic<BlockReader*> reader{nullptr};
+  BlockSink sink;
+};
+
+void on_blocks(dds_entity_t, void* arg) {
+  auto* state = static_cast<ListenerState*>(arg);
+  BlockReader* reader = state->reader.load();
+  if (reader == nullptr) return;  // not constructed yet: taken at the next notification
+  const std::lock_guard lock(state->mutex);
+  reader->take_each_cdr(state->sink);
+}
+
+// mode "waitset": a thread of ours waits and takes, as MapClient::poll; "listener": see above.
+int run_reader(int domain, const std::string& ns, bool latency, const std::string& mode) {
   sd::Participant p(domain);
   sd::Topic<sd::msg::SemanticMapBlock> topic(p, sd::topic_name(ns, sd::SemapTopic::kMapBlocks));
-  sd::Reader<sd::msg::SemanticMapBlock> reader(p, topic, sd::topic_qos(sd::SemapTopic::kMapBlocks));
+  ListenerState state;
+  state.sink.latency = latency;
+  std::unique_ptr<dds_listener_t, decltype(&dds_delete_listener)> listener(
+      mode == "listener" ? dds_create_listener(&state) : nullptr, &dds_delete_listener);
+  if (listener) dds_lset_data_available(listener.get(), on_blocks);
+  BlockReader reader(p, topic, sd::topic_qos(sd::SemapTopic::kMapBlocks), listener.get());
+  state.reader = &reader;
   while (reader.matched() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   std::cout << "ready" << std::endl;
   const double cpu0 = cpu_seconds();
-  std::uint64_t n = 0, bad = 0, bytes = 0;
-  Clock::time_point first, last;
-  std::vector<double> latencies_us;
-  const sd::BlockLimits limits;
-  std::unordered_map<sd::BlockIndex, sd::BlockSnapshot, sd::BlockIndexHash> map;
-  for (;;) {
-    const bool got = reader.wait(std::chrono::milliseconds(n == 0 ? 20000 : 1500));
-    if (!got) break;
-    reader.take_each([&](const sd::msg::SemanticMapBlock& m, const dds_sample_info_t&) {
-      const Stamp now = Stamp::now();
-      // Validation and copy into the block's map entry as the MapClient does them, so the
-      // figure is our stack's.
-      if (sd::check_block(m, limits).ok()) {
-        sd::copy_block(m, map[sd::BlockIndex{m.ix_, m.iy_, m.iz_}]);
-      } else {
-        ++bad;
-      }
-      if (n == 0) first = Clock::now();
-      last = Clock::now();
-      ++n;
-      bytes += block_bytes(m.block_cells_);
-      if (latency) {
-        latencies_us.push_back(
-            static_cast<double>(now.ns - sd::from_msg_time(m.header_.stamp_).ns) * 1e-3);
-      }
-    });
+  const BlockSink& sink = state.sink;
+  if (listener) {
+    const auto start = Clock::now();
+    for (;;) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const std::lock_guard lock(state.mutex);
+      const auto idle = sink.n == 0 ? Clock::now() - start : Clock::now() - sink.last;
+      if (idle > std::chrono::milliseconds(sink.n == 0 ? 20000 : 1500)) break;
+    }
+    dds_set_listener(reader.handle(), nullptr);
+  } else {
+    while (reader.wait(std::chrono::milliseconds(sink.n == 0 ? 20000 : 1500))) {
+      reader.take_each_cdr(state.sink);
+    }
   }
-  const double secs = std::chrono::duration<double>(last - first).count();
+  const std::lock_guard lock(state.mutex);
+  const double secs = std::chrono::duration<double>(sink.last - sink.first).count();
   // The reader's CPU time includes the final idle wait, which costs next to nothing.
-  std::cout << "result " << n << " " << bytes << " " << secs << " " << bad << " "
+  std::cout << "result " << sink.n << " " << sink.bytes << " " << secs << " " << sink.bad << " "
             << cpu_seconds() - cpu0;
-  if (latency && !latencies_us.empty()) {
-    std::sort(latencies_us.begin(), latencies_us.end());
+  if (latency && !sink.latencies_us.empty()) {
+    std::vector<double> l = sink.latencies_us;
+    std::sort(l.begin(), l.end());
     const auto pct = [&](double q) {
-      return latencies_us[std::min(
-          latencies_us.size() - 1,
-          static_cast<std::size_t>(q * static_cast<double>(latencies_us.size())))];
+      return l[std::min(l.size() - 1, static_cast<std::size_t>(q * static_cast<double>(l.size())))];
     };
-    std::cout << " " << pct(0.5) << " " << pct(0.99) << " " << latencies_us.back();
+    std::cout << " " << pct(0.5) << " " << pct(0.99) << " " << l.back();
   }
   std::cout << std::endl;
   return 0;
@@ -174,6 +220,7 @@ struct Throughput {
   double written_per_s = 0;
   double writer_cpu_us = 0;  // writer process CPU time per written block
   double reader_cpu_us = 0;  // reader process CPU time per received block
+  std::uint64_t written = 0;
   std::uint64_t received = 0;
   std::uint64_t bad = 0;
   std::uint64_t write_timeouts = 0;  // writes that waited max_blocking_time for the reader
@@ -184,9 +231,14 @@ struct Throughput {
   std::int64_t writer_involuntary_switches = 0;
 };
 
-Throughput throughput(int domain, std::uint16_t cells, double seconds) {
+// One throughput run. rate 0: the writer goes as fast as it can (saturating: with keep-last 1
+// the reader takes only the latest version of a block, so versions it was too slow for are
+// received by its DDS threads and then replaced unseen). rate > 0: the writer is paced to
+// `rate` blocks/s in rounds of 1000, to find the rate the reader takes in full.
+Throughput throughput(int domain, std::uint16_t cells, double seconds, double rate = 0.0,
+                      const std::string& mode = "waitset") {
   const std::string ns = "bench_tp" + std::to_string(cells);
-  Pipe reader(self_path() + " --reader " + std::to_string(domain) + " " + ns + " 0");
+  Pipe reader(self_path() + " --reader " + std::to_string(domain) + " " + ns + " 0 " + mode);
   sd::Participant p(domain);
   sd::MapPublisherConfig cfg;
   cfg.ns = ns;
@@ -214,6 +266,11 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
       pub.update(b);
     }
     written += pub.publish_changed(Stamp::now());
+    if (rate > 0.0) {
+      std::this_thread::sleep_until(
+          start + std::chrono::duration_cast<Clock::duration>(
+                      std::chrono::duration<double>(static_cast<double>(written) / rate)));
+    }
   }
   const double wsecs = std::chrono::duration<double>(Clock::now() - start).count();
   const double wcpu = cpu_seconds() - cpu0;
@@ -225,6 +282,7 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
   double secs = 0, rcpu = 0;
   r >> n >> bytes >> secs >> bad >> rcpu;
   Throughput t;
+  t.written = written;
   t.received = n;
   t.bad = bad;
   t.blocks_per_s = secs > 0 ? static_cast<double>(n) / secs : 0;
@@ -239,6 +297,34 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds) {
   return t;
 }
 
+// Paced runs at fractions of ddsperf's default rate: the highest whose blocks the reader takes
+// in full (at least 99 % of those written) is the figure to set against ddsperf's default,
+// whose keep-all writer is held to its reader's pace by flow control, so that every sample it
+// sends is taken. The saturating figure instead counts only the versions the reader got to
+// before newer ones replaced them. Each step is printed: on a shared machine a stall of the
+// reader longer than one round (1000 blocks) loses versions at any rate.
+struct Matched {
+  double blocks_per_s = 0;
+  double reader_cpu_us = 0;
+  double writer_cpu_us = 0;
+};
+
+Matched matched_rate(int domain, std::uint16_t cells, double seconds, double ddsperf_default) {
+  Matched best;
+  std::printf("  paced writer at %% of ddsperf default: received/s (%% of written)");
+  for (double fraction : {0.25, 0.35, 0.5, 0.6, 0.75}) {
+    const Throughput t = throughput(domain, cells, seconds, fraction * ddsperf_default, "listener");
+    const double taken = t.written > 0 ? static_cast<double>(t.received) / t.written : 0.0;
+    std::printf(" %.0f%%: %.0f (%.1f%%)", 100.0 * fraction, t.blocks_per_s, 100.0 * taken);
+    std::fflush(stdout);
+    if (taken >= 0.99 && t.blocks_per_s > best.blocks_per_s) {
+      best = {t.blocks_per_s, t.reader_cpu_us, t.writer_cpu_us};
+    }
+  }
+  std::printf("\n");
+  return best;
+}
+
 struct Latency {
   double p50_us = 0, p99_us = 0, max_us = 0;
   std::uint64_t samples = 0;
@@ -246,7 +332,7 @@ struct Latency {
 
 Latency latency(int domain, std::uint16_t cells, int blocks_per_update, double seconds) {
   const std::string ns = "bench_lat" + std::to_string(blocks_per_update);
-  Pipe reader(self_path() + " --reader " + std::to_string(domain) + " " + ns + " 1");
+  Pipe reader(self_path() + " --reader " + std::to_string(domain) + " " + ns + " 1 waitset");
   sd::Participant p(domain);
   sd::MapPublisherConfig cfg;
   cfg.ns = ns;
@@ -305,14 +391,16 @@ int main(int argc, char** argv) {
   try {
     // Pin DDS to loopback unless the caller chose a configuration.
     setenv("CYCLONEDDS_URI", "file://" SEMAP_DDS_LOOPBACK_XML, 0);
-    if (argc == 5 && std::strcmp(argv[1], "--reader") == 0) {
-      return run_reader(std::atoi(argv[2]), argv[3], std::strcmp(argv[4], "1") == 0);
+    if (argc == 6 && std::strcmp(argv[1], "--reader") == 0) {
+      return run_reader(std::atoi(argv[2]), argv[3], std::strcmp(argv[4], "1") == 0, argv[5]);
     }
     std::random_device rd;
     const int domain = 1 + static_cast<int>(rd() % 200);
-    if (argc == 4 && std::strcmp(argv[1], "--throughput") == 0) {
+    if (argc >= 4 && argc <= 6 && std::strcmp(argv[1], "--throughput") == 0) {
       const auto cells = static_cast<std::uint16_t>(std::atoi(argv[2]));
-      const Throughput t = throughput(domain, cells, std::atof(argv[3]));
+      const double rate = argc >= 5 ? std::atof(argv[4]) : 0.0;
+      const Throughput t =
+          throughput(domain, cells, std::atof(argv[3]), rate, argc == 6 ? argv[5] : "waitset");
       std::printf("%u^3 cells: written %.0f/s received %.0f/s (%llu blocks, %llu invalid)\n", cells,
                   t.written_per_s, t.blocks_per_s, static_cast<unsigned long long>(t.received),
                   static_cast<unsigned long long>(t.bad));
@@ -331,8 +419,10 @@ int main(int argc, char** argv) {
     std::printf("dds_bench: domain %d, CYCLONEDDS_URI=%s, %.0f s a run, median of %d\n", domain,
                 std::getenv("CYCLONEDDS_URI"), seconds, reps);
     // ddsperf twice: its default (reliable keep-all, one key: the baseline) and with
-    // our map QoS (keep-last 1 over 1000 keys), which cannot throttle the writer.
-    std::printf("%-22s %10s %8s %10s %14s %6s %16s %6s\n", "map blocks (no evid.)", "blocks/s",
+    // our map QoS (keep-last 1 over 1000 keys), which cannot throttle the writer. Our reader
+    // twice: taking in a listener on Cyclone's receive thread, as ddsperf's subscriber does by
+    // default, and from a thread of ours woken by a waitset, as MapClient::poll does.
+    std::printf("%-26s %10s %8s %10s %14s %6s %16s %6s\n", "map blocks (no evidence)", "blocks/s",
                 "MB/s", "written/s", "ddsperf dflt/s", "ratio", "ddsperf k1 n1000", "ratio");
     // Interleaved repetitions, medians reported: load from other processes comes and goes.
     const auto median = [](std::vector<double> v) {
@@ -341,27 +431,45 @@ int main(int argc, char** argv) {
     };
     for (std::uint16_t cells : {5, 8}) {
       const std::size_t bytes = block_bytes(cells);
-      std::vector<double> ours, mbs, written, wcpu, rcpu, ref, ref_k1;
-      std::uint64_t bad = 0;
+      struct Series {
+        std::vector<double> received, mbs, written, wcpu, rcpu;
+        std::uint64_t bad = 0;
+        void add(const Throughput& t) {
+          received.push_back(t.blocks_per_s);
+          mbs.push_back(t.mb_per_s);
+          written.push_back(t.written_per_s);
+          wcpu.push_back(t.writer_cpu_us);
+          rcpu.push_back(t.reader_cpu_us);
+          bad += t.bad;
+        }
+      };
+      Series listener, waitset;
+      std::vector<double> ref, ref_k1;
       for (int rep = 0; rep < reps; ++rep) {
-        const Throughput t = throughput(domain, cells, seconds);
-        ours.push_back(t.blocks_per_s);
-        mbs.push_back(t.mb_per_s);
-        written.push_back(t.written_per_s);
-        wcpu.push_back(t.writer_cpu_us);
-        rcpu.push_back(t.reader_cpu_us);
-        bad += t.bad;
+        listener.add(throughput(domain, cells, seconds, 0.0, "listener"));
+        waitset.add(throughput(domain, cells, seconds, 0.0, "waitset"));
         ref.push_back(ddsperf_rate(domain, bytes, seconds, ""));
         ref_k1.push_back(ddsperf_rate(domain, bytes, seconds, " -k 1 -n 1000"));
       }
-      const double o = median(ours), r = median(ref), r1 = median(ref_k1);
-      char label[64];
-      std::snprintf(label, sizeof label, "%u^3 cells, %zu B", cells, bytes);
-      std::printf("%-22s %10.0f %8.1f %10.0f %14.0f %5.0f%% %16.0f %5.0f%%%s\n", label, o,
-                  median(mbs), median(written), r, r > 0 ? 100.0 * o / r : 0.0, r1,
-                  r1 > 0 ? 100.0 * o / r1 : 0.0, bad ? " (INVALID BLOCKS RECEIVED)" : "");
-      std::printf("  CPU per block (all threads): writer %.1f us, reader %.1f us\n", median(wcpu),
-                  median(rcpu));
+      const double r = median(ref), r1 = median(ref_k1);
+      for (const auto& [name, series] : {std::pair{"listener", &listener}, {"waitset", &waitset}}) {
+        const double o = median(series->received);
+        char label[64];
+        std::snprintf(label, sizeof label, "%u^3 cells, %zu B, %s", cells, bytes, name);
+        std::printf("%-26s %10.0f %8.1f %10.0f %14.0f %5.0f%% %16.0f %5.0f%%%s\n", label, o,
+                    median(series->mbs), median(series->written), r, r > 0 ? 100.0 * o / r : 0.0,
+                    r1, r1 > 0 ? 100.0 * o / r1 : 0.0,
+                    series->bad ? " (INVALID BLOCKS RECEIVED)" : "");
+        std::printf("  CPU per block (all threads): writer %.1f us, reader %.1f us\n",
+                    median(series->wcpu), median(series->rcpu));
+      }
+      std::fflush(stdout);
+      const Matched m = matched_rate(domain, cells, seconds, r);
+      std::printf(
+          "  matched rate (listener, writer paced, >= 99 %% taken): %.0f blocks/s, %.0f%% of"
+          " ddsperf default; CPU per block writer %.1f us, reader %.1f us\n",
+          m.blocks_per_s, r > 0 ? 100.0 * m.blocks_per_s / r : 0.0, m.writer_cpu_us,
+          m.reader_cpu_us);
       std::fflush(stdout);
     }
     for (int per_update : {10, 100}) {

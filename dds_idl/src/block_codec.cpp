@@ -47,23 +47,78 @@ const char* to_string(BlockReject reason) {
       return "value out of range";
     case BlockReject::kUnknownIndex:
       return "unknown block index";
+    case BlockReject::kMalformed:
+      return "malformed CDR";
   }
   return "?";
 }
 
 namespace {
 
-BlockCheck reject(const msg::SemanticMapBlock& m, BlockReject reason, const std::string& what) {
+// The fields check_block looks at, from either form of a block (a DDS sample or a
+// BlockSnapshot read from CDR), so both are held to the same rules and messages.
+struct BlockFields {
+  std::int32_t ix, iy, iz;
+  float resolution;
+  std::uint16_t block_cells, num_classes;
+  std::uint32_t version;
+  const std::uint8_t* state;
+  std::size_t state_length;
+  const std::uint16_t* argmax_class;
+  std::size_t argmax_class_length;
+  const float* variance;
+  std::size_t variance_length;
+  const float* evidence;
+  std::size_t evidence_length;
+};
+
+BlockFields fields_of(const msg::SemanticMapBlock& m) {
+  return {m.ix_,
+          m.iy_,
+          m.iz_,
+          m.resolution_,
+          m.block_cells_,
+          m.num_classes_,
+          m.version_,
+          m.state_._buffer,
+          m.state_._length,
+          m.argmax_class_._buffer,
+          m.argmax_class_._length,
+          m.variance_._buffer,
+          m.variance_._length,
+          m.evidence_._buffer,
+          m.evidence_._length};
+}
+
+BlockFields fields_of(const BlockSnapshot& b) {
+  static_assert(sizeof(CellState) == sizeof(std::uint8_t));
+  return {b.index.x,
+          b.index.y,
+          b.index.z,
+          b.resolution,
+          b.block_cells,
+          b.num_classes,
+          b.version,
+          reinterpret_cast<const std::uint8_t*>(b.state.data()),
+          b.state.size(),
+          b.argmax_class.data(),
+          b.argmax_class.size(),
+          b.variance.data(),
+          b.variance.size(),
+          b.evidence.data(),
+          b.evidence.size()};
+}
+
+BlockCheck reject(const BlockFields& m, BlockReject reason, const std::string& what) {
   std::ostringstream os;
-  os << "SemanticMapBlock (" << m.ix_ << "," << m.iy_ << "," << m.iz_ << ") v" << m.version_ << ": "
+  os << "SemanticMapBlock (" << m.ix << "," << m.iy << "," << m.iz << ") v" << m.version << ": "
      << what;
   return {reason, os.str()};
 }
 
-template <typename Seq>
-std::optional<std::size_t> first_bad_float(const Seq& s) {
-  for (std::uint32_t i = 0; i < s._length; ++i) {
-    if (!std::isfinite(s._buffer[i])) return i;
+std::optional<std::size_t> first_bad_float(const float* p, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(p[i])) return i;
   }
   return std::nullopt;
 }
@@ -90,81 +145,87 @@ bool all_finite_non_negative(const float* p, std::size_t n) {
 
 // Out of line: inlined into check_block, GCC 12 left these loops scalar (checked with
 // -fopt-info-vec).
-[[gnu::noinline]] bool cells_ok(const msg::SemanticMapBlock& m, std::size_t cells) {
-  return max_of(m.state_._buffer, cells) <= static_cast<std::uint8_t>(CellState::kOccupied) &&
-         max_of(m.argmax_class_._buffer, cells) < m.num_classes_ &&
-         all_finite_non_negative(m.variance_._buffer, cells) &&
-         all_finite_non_negative(m.evidence_._buffer, m.evidence_._length);
+[[gnu::noinline]] bool cells_ok(const BlockFields& m, std::size_t cells) {
+  return max_of(m.state, cells) <= static_cast<std::uint8_t>(CellState::kOccupied) &&
+         max_of(m.argmax_class, cells) < m.num_classes &&
+         all_finite_non_negative(m.variance, cells) &&
+         all_finite_non_negative(m.evidence, m.evidence_length);
 }
 
 // The first offending value, in the order the checks are documented: non-finite values, then
 // per cell state, class and variance, then negative evidence.
-BlockCheck find_bad_cell(const msg::SemanticMapBlock& m, std::size_t cells) {
-  if (auto i = first_bad_float(m.variance_)) {
+BlockCheck find_bad_cell(const BlockFields& m, std::size_t cells) {
+  if (auto i = first_bad_float(m.variance, m.variance_length)) {
     return reject(m, BlockReject::kNonFinite, "variance[" + std::to_string(*i) + "]");
   }
-  if (auto i = first_bad_float(m.evidence_)) {
+  if (auto i = first_bad_float(m.evidence, m.evidence_length)) {
     return reject(m, BlockReject::kNonFinite, "evidence[" + std::to_string(*i) + "]");
   }
   for (std::size_t i = 0; i < cells; ++i) {
-    if (m.state_._buffer[i] > static_cast<std::uint8_t>(CellState::kOccupied)) {
+    if (m.state[i] > static_cast<std::uint8_t>(CellState::kOccupied)) {
       return reject(m, BlockReject::kOutOfRange, "state[" + std::to_string(i) + "]");
     }
-    if (m.argmax_class_._buffer[i] >= m.num_classes_) {
+    if (m.argmax_class[i] >= m.num_classes) {
       return reject(m, BlockReject::kOutOfRange, "argmax_class[" + std::to_string(i) + "]");
     }
-    if (m.variance_._buffer[i] < 0.0f) {
+    if (m.variance[i] < 0.0f) {
       return reject(m, BlockReject::kOutOfRange, "variance[" + std::to_string(i) + "] < 0");
     }
   }
-  for (std::uint32_t i = 0; i < m.evidence_._length; ++i) {
-    if (m.evidence_._buffer[i] < 0.0f) {
+  for (std::size_t i = 0; i < m.evidence_length; ++i) {
+    if (m.evidence[i] < 0.0f) {
       return reject(m, BlockReject::kOutOfRange, "evidence[" + std::to_string(i) + "] < 0");
     }
   }
   return {};
 }
 
-}  // namespace
-
-BlockCheck check_block(const msg::SemanticMapBlock& m, const BlockLimits& limits) {
+BlockCheck check_fields(const BlockFields& m, const BlockLimits& limits) {
   const auto index_ok = [&](std::int32_t v) {
     return v >= -limits.max_abs_index && v <= limits.max_abs_index;
   };
-  if (!index_ok(m.ix_) || !index_ok(m.iy_) || !index_ok(m.iz_)) {
+  if (!index_ok(m.ix) || !index_ok(m.iy) || !index_ok(m.iz)) {
     return reject(m, BlockReject::kUnknownIndex,
                   "index beyond +-" + std::to_string(limits.max_abs_index));
   }
-  if (!std::isfinite(m.resolution_) || m.resolution_ <= 0.0f ||
+  if (!std::isfinite(m.resolution) || m.resolution <= 0.0f ||
       (limits.resolution > 0.0f &&
-       std::fabs(m.resolution_ - limits.resolution) > 1e-6f * limits.resolution)) {
-    return reject(m, BlockReject::kShape, "resolution " + std::to_string(m.resolution_));
+       std::fabs(m.resolution - limits.resolution) > 1e-6f * limits.resolution)) {
+    return reject(m, BlockReject::kShape, "resolution " + std::to_string(m.resolution));
   }
-  if (m.block_cells_ == 0 || m.block_cells_ > 64 ||
-      (limits.block_cells != 0 && m.block_cells_ != limits.block_cells)) {
-    return reject(m, BlockReject::kShape, "block_cells " + std::to_string(m.block_cells_));
+  if (m.block_cells == 0 || m.block_cells > 64 ||
+      (limits.block_cells != 0 && m.block_cells != limits.block_cells)) {
+    return reject(m, BlockReject::kShape, "block_cells " + std::to_string(m.block_cells));
   }
-  if (m.num_classes_ == 0 || (limits.num_classes != 0 && m.num_classes_ != limits.num_classes)) {
+  if (m.num_classes == 0 || (limits.num_classes != 0 && m.num_classes != limits.num_classes)) {
     return reject(m, BlockReject::kClassCount,
-                  "num_classes " + std::to_string(m.num_classes_) + ", map has " +
+                  "num_classes " + std::to_string(m.num_classes) + ", map has " +
                       std::to_string(limits.num_classes));
   }
-  const std::size_t cells =
-      static_cast<std::size_t>(m.block_cells_) * m.block_cells_ * m.block_cells_;
-  if (m.state_._length != cells || m.argmax_class_._length != cells ||
-      m.variance_._length != cells) {
+  const std::size_t cells = static_cast<std::size_t>(m.block_cells) * m.block_cells * m.block_cells;
+  if (m.state_length != cells || m.argmax_class_length != cells || m.variance_length != cells) {
     return reject(m, BlockReject::kShape,
-                  "state/argmax_class/variance lengths " + std::to_string(m.state_._length) + "/" +
-                      std::to_string(m.argmax_class_._length) + "/" +
-                      std::to_string(m.variance_._length) + ", expected " + std::to_string(cells));
+                  "state/argmax_class/variance lengths " + std::to_string(m.state_length) + "/" +
+                      std::to_string(m.argmax_class_length) + "/" +
+                      std::to_string(m.variance_length) + ", expected " + std::to_string(cells));
   }
-  if (m.evidence_._length != 0 && m.evidence_._length != cells * m.num_classes_) {
+  if (m.evidence_length != 0 && m.evidence_length != cells * m.num_classes) {
     return reject(m, BlockReject::kClassCount,
-                  "evidence length " + std::to_string(m.evidence_._length) + " is not cells * " +
-                      std::to_string(m.num_classes_));
+                  "evidence length " + std::to_string(m.evidence_length) + " is not cells * " +
+                      std::to_string(m.num_classes));
   }
   if (cells_ok(m, cells)) return {};
   return find_bad_cell(m, cells);
+}
+
+}  // namespace
+
+BlockCheck check_block(const msg::SemanticMapBlock& m, const BlockLimits& limits) {
+  return check_fields(fields_of(m), limits);
+}
+
+BlockCheck check_block(const BlockSnapshot& b, const BlockLimits& limits) {
+  return check_fields(fields_of(b), limits);
 }
 
 void copy_block(const msg::SemanticMapBlock& m, BlockSnapshot& out) {

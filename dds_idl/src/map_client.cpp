@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "semap/common/logging.hpp"
+#include "semap/dds_idl/block_cdr.hpp"
 #include "semap/dds_idl/topic_names.hpp"
 
 namespace semap::dds_idl {
@@ -24,8 +25,9 @@ std::size_t MapClient::poll() {
   // MapInfo first: it may fix the shape the blocks are checked against.
   info_reader_.take_each([this](const msg::MapInfo& m, const dds_sample_info_t&) { on_info(m); });
   const std::uint64_t before = counters_.accepted;
-  block_reader_.take_each(
-      [this](const msg::SemanticMapBlock& m, const dds_sample_info_t&) { on_block(m); });
+  // Serialised blocks, read by read_block_cdr: Cyclone's deserialiser and a copy skipped.
+  block_reader_.take_each_cdr(
+      [this](std::span<const std::uint8_t> cdr, const dds_sample_info_t&) { on_block(cdr); });
   return static_cast<std::size_t>(counters_.accepted - before);
 }
 
@@ -65,8 +67,10 @@ void MapClient::on_info(const msg::MapInfo& m) {
   }
 }
 
-void MapClient::on_block(const msg::SemanticMapBlock& m) {
-  BlockCheck c = check_block(m, config_.limits);
+void MapClient::on_block(std::span<const std::uint8_t> cdr) {
+  common::Stamp stamp;
+  BlockCheck c = read_block_cdr(cdr, scratch_, stamp);
+  if (c.ok()) c = check_block(scratch_, config_.limits);
   if (!c.ok()) {
     ++counters_.rejected[static_cast<std::size_t>(c.reason)];
     last_error_ = std::move(c.error);
@@ -75,18 +79,17 @@ void MapClient::on_block(const msg::SemanticMapBlock& m) {
   }
   BlockLimits& l = config_.limits;
   // Without MapInfo the first valid block fixes the shape of the map.
-  if (l.num_classes == 0) l.num_classes = m.num_classes_;
-  if (l.block_cells == 0) l.block_cells = m.block_cells_;
-  if (l.resolution <= 0.0f) l.resolution = m.resolution_;
+  if (l.num_classes == 0) l.num_classes = scratch_.num_classes;
+  if (l.block_cells == 0) l.block_cells = scratch_.block_cells;
+  if (l.resolution <= 0.0f) l.resolution = scratch_.resolution;
 
-  const BlockIndex index{m.ix_, m.iy_, m.iz_};
+  const BlockIndex index = scratch_.index;
   auto [it, inserted] = blocks_.try_emplace(index);
-  if (!inserted && it->second.version > m.version_) {
+  if (!inserted && it->second.version > scratch_.version) {
     ++counters_.stale;
     return;
   }
-  // Into the block's existing storage: a new version of a known block allocates nothing.
-  copy_block(m, it->second);
+  std::swap(it->second, scratch_);
   changed_.push_back(index);
   ++counters_.accepted;
 }

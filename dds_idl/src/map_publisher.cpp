@@ -34,7 +34,7 @@ MapPublisher::MapPublisher(const Participant& participant, MapPublisherConfig co
   }
 }
 
-void MapPublisher::update(BlockSnapshot block) {
+void MapPublisher::check_shape(const BlockSnapshot& block) const {
   const std::size_t cells = block.cell_count();
   const bool shape_ok =
       block.resolution == description_.resolution &&
@@ -45,11 +45,25 @@ void MapPublisher::update(BlockSnapshot block) {
   if (!shape_ok) {
     throw std::invalid_argument("MapPublisher::update: block shape differs from the map's");
   }
-  const BlockIndex index = block.index;
-  auto [it, inserted] = blocks_.insert_or_assign(index, std::move(block));
-  (void)it;
+}
+
+void MapPublisher::mark_changed(const BlockIndex& index, bool inserted) {
   if (inserted) info_dirty_ = true;
   changed_.insert(index);
+}
+
+void MapPublisher::update(BlockSnapshot&& block) {
+  check_shape(block);
+  const BlockIndex index = block.index;
+  const bool inserted = blocks_.insert_or_assign(index, std::move(block)).second;
+  mark_changed(index, inserted);
+}
+
+void MapPublisher::update(const BlockSnapshot& block) {
+  check_shape(block);
+  auto [it, inserted] = blocks_.try_emplace(block.index);
+  it->second = block;  // vector copy-assignment keeps the old version's buffers
+  mark_changed(block.index, inserted);
 }
 
 std::size_t MapPublisher::spin_once(common::Stamp now) {

@@ -40,10 +40,15 @@ TEST(BlockCodec, RoundTripKeepsEveryField) {
   }
 }
 
-// Decodes `b` after `spoil` changed its message or limits.
+// Decodes `b` after `spoil` changed its message or limits, and checks that the C++ form of
+// the block (what read_block_cdr gives MapClient) gets the same verdict and message.
 DecodedBlock decode_spoiled(BlockSnapshot b, const BlockLimits& limits = {}) {
   const BlockMessage m(b, common::Stamp(1), "map");
-  return decode_block(m.get(), limits);
+  DecodedBlock d = decode_block(m.get(), limits);
+  const BlockCheck c = check_block(b, limits);
+  EXPECT_EQ(c.reason, d.reason);
+  EXPECT_EQ(c.error, d.error);
+  return d;
 }
 
 TEST(BlockCodec, RejectsEachKindOfBadBlockWithItsReason) {

@@ -41,6 +41,7 @@ enum class BlockReject : std::uint8_t {
   kNonFinite,     // NaN or inf in variance or evidence
   kOutOfRange,    // state code, class id, negative variance or evidence
   kUnknownIndex,  // block index outside the map's index range
+  kMalformed,     // serialised bytes that are not a SemanticMapBlock (read_block_cdr)
 };
 
 const char* to_string(BlockReject reason);
@@ -61,6 +62,9 @@ struct DecodedBlock {
 
 // Validates a received message without copying it. Never throws on bad data.
 BlockCheck check_block(const msg::SemanticMapBlock& m, const BlockLimits& limits);
+
+// The same checks for a block in C++ form, e.g. one read_block_cdr wrote.
+BlockCheck check_block(const BlockSnapshot& b, const BlockLimits& limits);
 
 // Copies a message that passed check_block into `out`, reusing out's storage (no allocation
 // when `out` already holds a block of the same shape, as a map's entry for that index does).

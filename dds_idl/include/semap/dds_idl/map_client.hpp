@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -24,7 +25,7 @@ struct MapClientConfig {
 struct MapClientCounters {
   std::uint64_t accepted = 0;
   std::uint64_t stale = 0;                  // older version than the block already held
-  std::array<std::uint64_t, 6> rejected{};  // indexed by BlockReject
+  std::array<std::uint64_t, 7> rejected{};  // indexed by BlockReject
   std::uint64_t infos = 0;
   std::uint64_t infos_rejected = 0;
 
@@ -68,7 +69,7 @@ class MapClient {
   void save_pcd(const std::filesystem::path& path) const;
 
  private:
-  void on_block(const msg::SemanticMapBlock& m);
+  void on_block(std::span<const std::uint8_t> cdr);
   void on_info(const msg::MapInfo& m);
 
   MapClientConfig config_;
@@ -77,6 +78,9 @@ class MapClient {
   Topic<msg::MapInfo> info_topic_;
   Reader<msg::MapInfo> info_reader_;
   std::unordered_map<BlockIndex, BlockSnapshot, BlockIndexHash> blocks_;
+  // A received block is read into this, checked, then swapped with its map entry, so that the
+  // entry's old buffers take the next block: no allocation per block of a known shape.
+  BlockSnapshot scratch_;
   std::vector<BlockIndex> changed_;
   std::optional<MapDescription> info_;
   MapClientCounters counters_;

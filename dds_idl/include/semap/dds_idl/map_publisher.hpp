@@ -40,7 +40,10 @@ class MapPublisher {
                MapDescription description);
 
   // Throws std::invalid_argument when the block's shape differs from the description.
-  void update(BlockSnapshot block);
+  void update(BlockSnapshot&& block);
+  // The same for a block the caller keeps: copied into the buffers of the version it replaces,
+  // so a new version of a known block allocates nothing.
+  void update(const BlockSnapshot& block);
   // Writes what is due at `now`; returns the number of blocks written.
   std::size_t spin_once(common::Stamp now);
   // Writes all pending blocks now, regardless of the rate. A write timeout ends the round
@@ -56,6 +59,9 @@ class MapPublisher {
 
  private:
   void publish_info(common::Stamp now);
+  void check_shape(const BlockSnapshot& block) const;
+  // Marks `index` changed; `inserted`: the map grew.
+  void mark_changed(const BlockIndex& index, bool inserted);
 
   MapPublisherConfig config_;
   MapDescription description_;
