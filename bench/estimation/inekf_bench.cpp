@@ -37,6 +37,13 @@ struct Inputs {
   }
 };
 
+// The GNSS fix model both correction benchmarks use: 1 m noise, antenna lever arm, 99.9 % gate.
+struct GnssSetup {
+  double gate2 = semap::estimation::chi_square_quantile(0.999, 3);
+  Eigen::Matrix3d noise = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d lever{0.2, 0.0, 1.2};
+};
+
 NavState start_state() {
   NavState s;
   s.rotation = semap::estimation::rotation_from_rpy(0.01, -0.02, 0.7);
@@ -68,14 +75,13 @@ void gnss_correction(benchmark::State& state) {
   const Inputs in;
   Filter f{FilterParams{}};
   f.reset(start_state(), start_covariance());
-  const double gate2 = semap::estimation::chi_square_quantile(0.999, 3);
-  const Eigen::Matrix3d n = Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d lever(0.2, 0.0, 1.2);
+  const GnssSetup gnss;
   const NavState s = f.state();
-  const Eigen::Vector3d antenna = s.position + s.rotation * lever;
+  const Eigen::Vector3d antenna = s.position + s.rotation * gnss.lever;
   std::size_t i = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(f.correct_position(antenna + in.noise[i], n, lever, gate2));
+    benchmark::DoNotOptimize(
+        f.correct_position(antenna + in.noise[i], gnss.noise, gnss.lever, gnss.gate2));
     i = (i + 1) % kInputs;
   }
 }
@@ -85,9 +91,7 @@ void mix_per_imu_sample(benchmark::State& state) {
   const Inputs in;
   Filter f{FilterParams{}};
   f.reset(start_state(), start_covariance());
-  const double gate2 = semap::estimation::chi_square_quantile(0.999, 3);
-  const Eigen::Matrix3d n = Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d lever(0.2, 0.0, 1.2);
+  const GnssSetup gnss;
   std::size_t i = 0;
   for (auto _ : state) {
     f.propagate(in.gyro[i], in.accel[i], 0.01);
@@ -98,7 +102,8 @@ void mix_per_imu_sample(benchmark::State& state) {
     if (i % 10 == 9) {  // GNSS at 10 Hz, around the current estimate
       const NavState s = f.state();
       benchmark::DoNotOptimize(
-          f.correct_position(s.position + s.rotation * lever + 0.3 * in.noise[i], n, lever, gate2));
+          f.correct_position(s.position + s.rotation * gnss.lever + 0.3 * in.noise[i], gnss.noise,
+                             gnss.lever, gnss.gate2));
     }
     i = (i + 1) % kInputs;
     benchmark::DoNotOptimize(f);
