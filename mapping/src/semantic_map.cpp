@@ -1,8 +1,14 @@
 #include "semap/mapping/semantic_map.hpp"
 
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
 #include <array>
 #include <cmath>
+#include <exception>
+#include <memory>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "semap/mapping/voxel_hash_map.hpp"
@@ -27,12 +33,63 @@ SemanticMap::SemanticMap(SemanticMap&&) noexcept = default;
 SemanticMap& SemanticMap::operator=(SemanticMap&&) noexcept = default;
 
 InsertResult SemanticMap::insert(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin) {
-  const TrainingSet training = build_training_set(cloud, origin, params_);
+  return insert_built(build_training_set(cloud, origin, params_));
+}
+
+InsertResult SemanticMap::insert_built(const TrainingSet& training) {
   InsertResult result = insert(training);
   result.rejected_points += training.rejected;
   result.out_of_range = training.out_of_range;
   rejected_ += training.rejected;
   return result;
+}
+
+std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledCloud> clouds,
+                                              std::span<const Eigen::Vector3f> origins) {
+  if (clouds.size() != origins.size()) {
+    throw std::invalid_argument(std::to_string(clouds.size()) + " clouds but " +
+                                std::to_string(origins.size()) + " origins");
+  }
+  // A scan's training set, or the exception its build threw: kept until the serial stage
+  // reaches that scan, so the scans before it are fused first.
+  struct Built {
+    TrainingSet training;
+    std::exception_ptr error;
+  };
+  std::vector<InsertResult> results;
+  results.reserve(clouds.size());
+  std::size_t next = 0;
+  // One scan in the serial stage and one being built per further thread; more would only
+  // hold training sets in memory (the order of fusion, hence the map, does not depend on it).
+  const auto scans_in_flight =
+      static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()) + 1;
+  tbb::parallel_pipeline(
+      scans_in_flight,
+      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                          [&](tbb::flow_control& control) -> std::size_t {
+                                            if (next == clouds.size()) {
+                                              control.stop();
+                                              return 0;
+                                            }
+                                            return next++;
+                                          }) &
+          tbb::make_filter<std::size_t, std::shared_ptr<Built>>(
+              tbb::filter_mode::parallel,
+              [&](std::size_t scan) {
+                auto built = std::make_shared<Built>();
+                try {
+                  built->training = build_training_set(clouds[scan], origins[scan], params_);
+                } catch (...) {
+                  built->error = std::current_exception();
+                }
+                return built;
+              }) &
+          tbb::make_filter<std::shared_ptr<Built>, void>(
+              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Built>& built) {
+                if (built->error) std::rethrow_exception(built->error);
+                results.push_back(insert_built(built->training));
+              }));
+  return results;
 }
 
 InsertResult SemanticMap::insert(const TrainingSet& training) {

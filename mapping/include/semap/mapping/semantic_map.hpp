@@ -61,6 +61,15 @@ class SemanticMap {
 
   // Builds the scan's training set (see build_training_set) and fuses it.
   InsertResult insert(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin);
+  // Inserts clouds[i] seen from origins[i] in order, with the same map and results as calling
+  // insert(clouds[i], origins[i]) one after the other, but builds the training sets of the
+  // next scans (they do not depend on the map) while the current one is fused: a
+  // tbb::parallel_pipeline whose parallel stage builds training sets and whose serial,
+  // in-order stage fuses them. If a scan's build throws, the scans before it are inserted and
+  // the exception is rethrown, as in the loop. Throws std::invalid_argument when the spans
+  // differ in length.
+  std::vector<InsertResult> insert(std::span<const common::LabeledCloud> clouds,
+                                   std::span<const Eigen::Vector3f> origins);
   // Fuses a prepared training set: each point adds k(d) y to every cell centre within ell
   // (S-BKI) or y to the cell containing it (S-CSM).
   InsertResult insert(const TrainingSet& training);
@@ -98,6 +107,8 @@ class SemanticMap {
 
  private:
   Block& block_at(const BlockIndex& index);
+  // insert(training) plus the training set's own rejected and out-of-range counts.
+  InsertResult insert_built(const TrainingSet& training);
 
   MapParams params_;
   KernelTable kernel_;
