@@ -57,9 +57,12 @@ int main(int argc, char** argv) {
       return 0;
     }
     semap::mapping::SemanticMap map(params);
+    std::vector<Eigen::Vector3f> origins;
+    for (const auto& cloud : clouds) origins.push_back(cloud.origin);
     std::size_t rejected = 0;
     const auto start = std::chrono::steady_clock::now();
-    for (const auto& cloud : clouds) rejected += map.insert(cloud, cloud.origin).rejected_points;
+    // In the order given; the batch builds the next scans' training sets while one is fused.
+    for (const auto& result : map.insert(clouds, origins)) rejected += result.rejected_points;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
