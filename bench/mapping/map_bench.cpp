@@ -90,7 +90,16 @@ struct ToyTiming {
   std::size_t training_points = 0;
   semap::mapping::MapStats stats;
   std::uint64_t checksum = 0;
+  semap::mapping::InsertPhases phases;  // of the best run, summed over the scans
 };
+
+void add_phases(semap::mapping::InsertPhases& sum, const semap::mapping::InsertPhases& scan) {
+  sum.training += scan.training;
+  sum.prepare += scan.prepare;
+  sum.group += scan.group;
+  sum.blocks += scan.blocks;
+  sum.scatter += scan.scatter;
+}
 
 // How the 12 scans go in: one insert(cloud, origin) per scan, its training-set build timed
 // apart, or one batch insert(clouds, origins) that builds the next scans' training sets while
@@ -106,6 +115,7 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, ToyPa
     SemanticMap map(toy_params(method));
     double training = -1;
     std::size_t points = 0;
+    semap::mapping::InsertPhases phases;
     const double cpu0 = process_cpu_seconds();
     const auto start = Clock::now();
     if (path == ToyPath::kScan) {
@@ -115,10 +125,13 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, ToyPa
         const auto set = semap::mapping::build_training_set(c, c.origin, map.params());
         training += seconds_since(t0);
         points += set.size();
-        map.insert(set);
+        add_phases(phases, map.insert(set).phases);
       }
     } else {
-      for (const auto& result : map.insert(clouds, origins)) points += result.training_points;
+      for (const auto& result : map.insert(clouds, origins)) {
+        points += result.training_points;
+        add_phases(phases, result.phases);
+      }
     }
     const double total = seconds_since(start);
     const double cpu = process_cpu_seconds() - cpu0;
@@ -129,6 +142,8 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, ToyPa
       t.training_points = points;
       t.stats = map.stats();
       t.checksum = map_checksum(map);
+      t.phases = phases;
+      if (path == ToyPath::kScan) t.phases.training = training;
     }
   }
   return t;
@@ -142,6 +157,7 @@ void toy_figures(int repetitions) {
       repetitions);
   std::printf("%-5s %-8s %-6s %10s %10s %10s %10s %9s %8s  %s\n", "meth", "threads", "path",
               "insert_ms", "cpu_ms", "train_ms", "train_pts", "vs_ref", "B/cell", "map_fnv");
+  std::vector<std::pair<std::string, semap::mapping::InsertPhases>> phases;
   for (const Method method : {Method::kBki, Method::kCsm}) {
     for (const int threads : {1, 2}) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
@@ -157,8 +173,21 @@ void toy_figures(int repetitions) {
                     path == ToyPath::kScan ? "scan" : "batch", t.best_total * 1e3, t.cpu * 1e3,
                     training, t.training_points, ref / t.best_total, t.stats.bytes_per_cell(),
                     static_cast<unsigned long long>(t.checksum));
+        char row[32];
+        std::snprintf(row, sizeof row, "%-5s %-8d %-6s", semap::mapping::to_string(method).c_str(),
+                      threads, path == ToyPath::kScan ? "scan" : "batch");
+        phases.emplace_back(row, t.phases);
       }
     }
+  }
+  // Where the time goes. Batch: training sets are built while earlier scans are fused, so
+  // the phases add up to more than insert_ms.
+  std::printf("phases of the best run, ms summed over the 12 scans:\n");
+  std::printf("%-5s %-8s %-6s %9s %9s %9s %9s %9s\n", "meth", "threads", "path", "training",
+              "prepare", "group", "blocks", "scatter");
+  for (const auto& [row, p] : phases) {
+    std::printf("%s %9.2f %9.2f %9.2f %9.2f %9.2f\n", row.c_str(), p.training * 1e3,
+                p.prepare * 1e3, p.group * 1e3, p.blocks * 1e3, p.scatter * 1e3);
   }
 }
 

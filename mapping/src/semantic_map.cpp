@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <memory>
@@ -32,8 +33,29 @@ SemanticMap::~SemanticMap() = default;
 SemanticMap::SemanticMap(SemanticMap&&) noexcept = default;
 SemanticMap& SemanticMap::operator=(SemanticMap&&) noexcept = default;
 
+namespace {
+
+// The training set of a scan and the wall time its build took.
+struct TimedTraining {
+  TrainingSet training;
+  double seconds = 0;
+};
+
+TimedTraining build_timed(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin,
+                          const MapParams& params) {
+  const auto start = std::chrono::steady_clock::now();
+  TimedTraining built{build_training_set(cloud, origin, params)};
+  built.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return built;
+}
+
+}  // namespace
+
 InsertResult SemanticMap::insert(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin) {
-  return insert_built(build_training_set(cloud, origin, params_));
+  const TimedTraining built = build_timed(cloud, origin, params_);
+  InsertResult result = insert_built(built.training);
+  result.phases.training = built.seconds;
+  return result;
 }
 
 InsertResult SemanticMap::insert_built(const TrainingSet& training) {
@@ -53,7 +75,7 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
   // A scan's training set, or the exception its build threw: kept until the serial stage
   // reaches that scan, so the scans before it are fused first.
   struct Built {
-    TrainingSet training;
+    TimedTraining timed;
     std::exception_ptr error;
   };
   std::vector<InsertResult> results;
@@ -78,7 +100,7 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
               [&](std::size_t scan) {
                 auto built = std::make_shared<Built>();
                 try {
-                  built->training = build_training_set(clouds[scan], origins[scan], params_);
+                  built->timed = build_timed(clouds[scan], origins[scan], params_);
                 } catch (...) {
                   built->error = std::current_exception();
                 }
@@ -87,7 +109,8 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
           tbb::make_filter<std::shared_ptr<Built>, void>(
               tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Built>& built) {
                 if (built->error) std::rethrow_exception(built->error);
-                results.push_back(insert_built(built->training));
+                results.push_back(insert_built(built->timed.training));
+                results.back().phases.training = built->timed.seconds;
               }));
   return results;
 }
@@ -105,6 +128,7 @@ InsertResult SemanticMap::insert(const TrainingSet& training) {
   result.rejected_points = fused.rejected_points;
   rejected_ += fused.rejected_points;
   result.blocks_updated = fused.updated_blocks.size();
+  result.phases = fused.phases;
   result.updated_blocks = std::move(fused.updated_blocks);
   ++scans_;
   return result;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -36,6 +37,20 @@ bool empty(const CellBox& box) {
 }
 
 constexpr CellBox kEmptyBox{{0, 0, 0}, {-1, -1, -1}};
+
+// Seconds between successive lap() calls.
+class PhaseClock {
+ public:
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return seconds;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
 
 // Scratch tiles are 32 cells per side when that fits in kScratchBytes (K <= 4), else 16: big
 // enough that most supports fit in one (fewer pieces and split rows), small enough that the
@@ -400,11 +415,15 @@ void TileInserter::process_tile(std::size_t tile, const TrainingSet& training,
 TileInsertResult TileInserter::insert(const TrainingSet& training, const KernelTable& kernel,
                                       const BlockAt& block_at) {
   TileInsertResult result;
+  PhaseClock clock;
   prepare_points(training);
   result.rejected_points = static_cast<std::size_t>(std::count(bad_.begin(), bad_.end(), 1));
+  result.phases.prepare = clock.lap();
   group_by_tile(training.size());
+  result.phases.group = clock.lap();
   // Creating blocks mutates the map's table, so it happens before the parallel part.
   create_blocks(block_at, result);
+  result.phases.blocks = clock.lap();
   // Scratch tiles are big, uneven units of work: the busiest go first so that the last ones
   // to finish are small (the order cannot change results, tiles are independent). Blocks
   // written in place are small (S-CSM: a few points each) and go in groups of
@@ -425,6 +444,7 @@ TileInsertResult TileInserter::insert(const TrainingSet& training, const KernelT
         }
       },
       tbb::simple_partitioner());
+  result.phases.scatter = clock.lap();
   return result;
 }
 

@@ -17,6 +17,7 @@
 #include "semap/mapping/block_index.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
+#include "semap/mapping/semantic_map.hpp"
 #include "semap/mapping/training_data.hpp"
 #include "support_box.hpp"
 #include "voxel_grouping.hpp"
@@ -34,6 +35,7 @@ inline bool mappable(const Eigen::Vector3f& p, float inv_res) {
 struct TileInsertResult {
   std::size_t rejected_points = 0;
   std::vector<BlockIndex> updated_blocks;
+  InsertPhases phases;  // all but `training`
 };
 
 // A tile is a cube of cells, the unit of parallel work: 32 cells per side (16 when such a

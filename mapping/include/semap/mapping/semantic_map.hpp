@@ -34,6 +34,15 @@ struct MapStats {
   double bytes_per_cell() const { return cells ? static_cast<double>(bytes) / cells : 0.0; }
 };
 
+// Wall time of one insert's steps, in seconds (steady clock; map_bench prints them).
+struct InsertPhases {
+  double training = 0;  // build_training_set (0 when given a prepared training set)
+  double prepare = 0;   // per point: checks, support box, axis distances (parallel)
+  double group = 0;     // (point, tile) pairs, tile numbering, counting sort, block masks
+  double blocks = 0;    // creating missing blocks (serial: mutates the block table)
+  double scatter = 0;   // kernel sums into the tiles and write-back (parallel over tiles)
+};
+
 // What one insert did.
 struct InsertResult {
   std::size_t training_points = 0;
@@ -42,6 +51,7 @@ struct InsertResult {
   std::size_t out_of_range = 0;
   std::size_t blocks_updated = 0;
   std::vector<BlockIndex> updated_blocks;  // the blocks this insert wrote to
+  InsertPhases phases;
 };
 
 // The continuous semantic map of Gan et al. (S-CSM / S-BKI): a hash map of blocks of cells,
