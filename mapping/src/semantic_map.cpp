@@ -1,5 +1,6 @@
 #include "semap/mapping/semantic_map.hpp"
 
+#include <tbb/concurrent_queue.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -53,16 +54,8 @@ TimedTraining build_timed(const common::LabeledCloud& cloud, const Eigen::Vector
 
 InsertResult SemanticMap::insert(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin) {
   const TimedTraining built = build_timed(cloud, origin, params_);
-  InsertResult result = insert_built(built.training);
+  InsertResult result = fuse_scan(built.training, nullptr);
   result.phases.training = built.seconds;
-  return result;
-}
-
-InsertResult SemanticMap::insert_built(const TrainingSet& training) {
-  InsertResult result = insert(training);
-  result.rejected_points += training.rejected;
-  result.out_of_range = training.out_of_range;
-  rejected_ += training.rejected;
   return result;
 }
 
@@ -72,16 +65,20 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
     throw std::invalid_argument(std::to_string(clouds.size()) + " clouds but " +
                                 std::to_string(origins.size()) + " origins");
   }
-  // A scan's training set, or the exception its build threw: kept until the serial stage
-  // reaches that scan, so the scans before it are fused first.
-  struct Built {
+  // A scan's training set and tile plan (neither depends on the map), or the exception the
+  // build threw: kept until the serial stage reaches that scan, so the scans before it are
+  // fused first.
+  struct Prepared {
     TimedTraining timed;
+    detail::TilePlan plan;
     std::exception_ptr error;
   };
+  // Fused scans' Prepared objects, reused so that their plans' buffers are not reallocated.
+  tbb::concurrent_queue<std::shared_ptr<Prepared>> spare;
   std::vector<InsertResult> results;
   results.reserve(clouds.size());
   std::size_t next = 0;
-  // One scan in the serial stage and one being built per further thread; more would only
+  // One scan in the serial stage and one being prepared per further thread; more would only
   // hold training sets in memory (the order of fusion, hence the map, does not depend on it).
   const auto scans_in_flight =
       static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()) + 1;
@@ -95,27 +92,40 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
                                             }
                                             return next++;
                                           }) &
-          tbb::make_filter<std::size_t, std::shared_ptr<Built>>(
+          tbb::make_filter<std::size_t, std::shared_ptr<Prepared>>(
               tbb::filter_mode::parallel,
               [&](std::size_t scan) {
-                auto built = std::make_shared<Built>();
+                std::shared_ptr<Prepared> prepared;
+                if (!spare.try_pop(prepared)) prepared = std::make_shared<Prepared>();
                 try {
-                  built->timed = build_timed(clouds[scan], origins[scan], params_);
+                  prepared->timed = build_timed(clouds[scan], origins[scan], params_);
+                  inserter_->plan(prepared->timed.training, prepared->plan);
                 } catch (...) {
-                  built->error = std::current_exception();
+                  prepared->error = std::current_exception();
                 }
-                return built;
+                return prepared;
               }) &
-          tbb::make_filter<std::shared_ptr<Built>, void>(
-              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Built>& built) {
-                if (built->error) std::rethrow_exception(built->error);
-                results.push_back(insert_built(built->timed.training));
-                results.back().phases.training = built->timed.seconds;
+          tbb::make_filter<std::shared_ptr<Prepared>, void>(
+              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Prepared>& prepared) {
+                if (prepared->error) std::rethrow_exception(prepared->error);
+                results.push_back(fuse_scan(prepared->timed.training, &prepared->plan));
+                results.back().phases.training = prepared->timed.seconds;
+                spare.push(prepared);
               }));
   return results;
 }
 
-InsertResult SemanticMap::insert(const TrainingSet& training) {
+InsertResult SemanticMap::insert(const TrainingSet& training) { return fuse(training, nullptr); }
+
+InsertResult SemanticMap::fuse_scan(const TrainingSet& training, detail::TilePlan* plan) {
+  InsertResult result = fuse(training, plan);
+  result.rejected_points += training.rejected;
+  result.out_of_range = training.out_of_range;
+  rejected_ += training.rejected;
+  return result;
+}
+
+InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* plan) {
   if (training.num_classes != params_.num_classes) {
     throw std::invalid_argument("training set has " + std::to_string(training.num_classes) +
                                 " classes, map has " + std::to_string(params_.num_classes));
@@ -123,8 +133,10 @@ InsertResult SemanticMap::insert(const TrainingSet& training) {
   InsertResult result;
   result.training_points = training.size();
   result.hits = training.num_hits;
-  detail::TileInsertResult fused = inserter_->insert(
-      training, kernel_, [this](const BlockIndex& index) -> Block& { return block_at(index); });
+  const auto block_at = [this](const BlockIndex& index) -> Block& { return this->block_at(index); };
+  detail::TileInsertResult fused = plan != nullptr
+                                       ? inserter_->apply(*plan, training, kernel_, block_at)
+                                       : inserter_->insert(training, kernel_, block_at);
   result.rejected_points = fused.rejected_points;
   rejected_ += fused.rejected_points;
   result.blocks_updated = fused.updated_blocks.size();

@@ -154,12 +154,12 @@ TileInserter::TileInserter(const MapParams& params)
                  : static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 3),
       scratch_(std::int32_t{1} << tile_shift_, params.num_classes) {}
 
-void TileInserter::prepare_points(const TrainingSet& training) {
+void TileInserter::prepare_points(const TrainingSet& training, TilePlan& plan) const {
   const std::size_t count = training.size();
-  boxes_.resize(count);
-  bad_.resize(count);
+  plan.boxes.resize(count);
+  plan.bad.resize(count);
   // Padded so that the row test may read 8 floats from any cell of the last point.
-  distances_.resize(count * 3 * width_ + 8);
+  plan.distances.resize(count * 3 * width_ + 8);
   const float inv_res = 1.0f / params_.resolution;
   const std::size_t soft_rows = training.probabilities.size() / params_.num_classes;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
@@ -169,15 +169,15 @@ void TileInserter::prepare_points(const TrainingSet& training) {
                         const bool label_ok =
                             label >= 0 ? label < params_.num_classes : i < soft_rows;
                         if (!label_ok || !mappable(training.points[i], inv_res)) {
-                          bad_[i] = 1;
-                          boxes_[i] = kEmptyBox;
+                          plan.bad[i] = 1;
+                          plan.boxes[i] = kEmptyBox;
                           continue;
                         }
-                        bad_[i] = 0;
+                        plan.bad[i] = 0;
                         const CellBox box = support_of(training.points[i], params_);
-                        boxes_[i] = box;
+                        plan.boxes[i] = box;
                         if (width_ == 0) continue;
-                        float* d2 = distances_.data() + i * 3 * width_;
+                        float* d2 = plan.distances.data() + i * 3 * width_;
                         for (int a = 0; a < 3; ++a, d2 += width_) {
                           // Widths never exceed width_ (2 ell / res + 1 at most).
                           for (std::int32_t c = box.lo[a]; c <= box.hi[a]; ++c) {
@@ -190,39 +190,39 @@ void TileInserter::prepare_points(const TrainingSet& training) {
                     });
 }
 
-void TileInserter::group_by_tile(std::size_t count) {
+void TileInserter::group_by_tile(std::size_t count, TilePlan& plan) const {
   const std::int32_t ts = tile_shift_;
   // 1. Tiles per point (parallel), then where each point's (point, tile) pairs start.
-  pair_first_.assign(count + 1, 0);
+  plan.pair_first.assign(count + 1, 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        const CellBox& box = boxes_[i];
+                        const CellBox& box = plan.boxes[i];
                         std::uint32_t tiles = empty(box) ? 0 : 1;
                         for (int a = 0; a < 3 && tiles; ++a) {
                           tiles *=
                               static_cast<std::uint32_t>((box.hi[a] >> ts) - (box.lo[a] >> ts) + 1);
                         }
-                        pair_first_[i + 1] = tiles;
+                        plan.pair_first[i + 1] = tiles;
                       }
                     });
-  for (std::size_t i = 0; i < count; ++i) pair_first_[i + 1] += pair_first_[i];
-  const std::size_t pairs = pair_first_[count];
+  for (std::size_t i = 0; i < count; ++i) plan.pair_first[i + 1] += plan.pair_first[i];
+  const std::size_t pairs = plan.pair_first[count];
   // 2. The tile of every pair, in point order (parallel).
-  pair_tiles_.resize(pairs);
-  pair_points_.resize(pairs);
+  plan.pair_tiles.resize(pairs);
+  plan.pair_points.resize(pairs);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        const CellBox& box = boxes_[i];
-                        std::size_t j = pair_first_[i];
-                        if (j == pair_first_[i + 1]) continue;
+                        const CellBox& box = plan.boxes[i];
+                        std::size_t j = plan.pair_first[i];
+                        if (j == plan.pair_first[i + 1]) continue;
                         for (std::int32_t tz = box.lo[2] >> ts; tz <= box.hi[2] >> ts; ++tz) {
                           for (std::int32_t ty = box.lo[1] >> ts; ty <= box.hi[1] >> ts; ++ty) {
                             for (std::int32_t tx = box.lo[0] >> ts; tx <= box.hi[0] >> ts;
                                  ++tx, ++j) {
-                              pair_tiles_[j] = BlockIndex{tx, ty, tz};
-                              pair_points_[j] = static_cast<std::uint32_t>(i);
+                              plan.pair_tiles[j] = BlockIndex{tx, ty, tz};
+                              plan.pair_points[j] = static_cast<std::uint32_t>(i);
                             }
                           }
                         }
@@ -231,67 +231,68 @@ void TileInserter::group_by_tile(std::size_t count) {
   // 3. Tiles numbered by first occurrence: scratch tiles are few (toy: 8..18 per scan), so a
   // short list searched from the last hit beats hashing every pair; many tiles (blocks
   // written in place, or a list that grows past kFewTiles) take parallel hash shards.
-  const bool few = tile_shift_ != block_shift_ && number_few_tiles(pairs);
+  const bool few = tile_shift_ != block_shift_ && number_few_tiles(pairs, plan);
   if (!few) {
-    tile_grouping_.group(pair_tiles_, {});
-    const auto ids = tile_grouping_.voxel_of();
-    pair_tile_ids_.assign(ids.begin(), ids.end());
-    tiles_.clear();
+    plan.tile_grouping.group(plan.pair_tiles, {});
+    const auto ids = plan.tile_grouping.voxel_of();
+    plan.pair_tile_ids.assign(ids.begin(), ids.end());
+    plan.tiles.clear();
     for (std::size_t j = 0; j < pairs; ++j) {
-      if (pair_tile_ids_[j] == tiles_.size()) tiles_.push_back(pair_tiles_[j]);
+      if (plan.pair_tile_ids[j] == plan.tiles.size()) plan.tiles.push_back(plan.pair_tiles[j]);
     }
   }
-  std::vector<std::uint32_t>& counts = fill_;
-  counts.assign(tiles_.size(), 0);
-  for (std::size_t j = 0; j < pairs; ++j) ++counts[pair_tile_ids_[j]];
+  std::vector<std::uint32_t>& counts = plan.fill;
+  counts.assign(plan.tiles.size(), 0);
+  for (std::size_t j = 0; j < pairs; ++j) ++counts[plan.pair_tile_ids[j]];
   // 4. Counting sort: each tile's points in ascending order.
-  tile_offsets_.assign(tiles_.size() + 1, 0);
-  for (std::size_t t = 0; t < tiles_.size(); ++t) {
-    tile_offsets_[t + 1] = tile_offsets_[t] + counts[t];
+  plan.tile_offsets.assign(plan.tiles.size() + 1, 0);
+  for (std::size_t t = 0; t < plan.tiles.size(); ++t) {
+    plan.tile_offsets[t + 1] = plan.tile_offsets[t] + counts[t];
   }
-  fill_.assign(tile_offsets_.begin(), tile_offsets_.end() - 1);
-  tile_points_.resize(pairs);
+  plan.fill.assign(plan.tile_offsets.begin(), plan.tile_offsets.end() - 1);
+  plan.tile_points.resize(pairs);
   for (std::size_t j = 0; j < pairs; ++j) {
-    tile_points_[fill_[pair_tile_ids_[j]]++] = pair_points_[j];
+    plan.tile_points[plan.fill[plan.pair_tile_ids[j]]++] = plan.pair_points[j];
   }
   // 5. Blocks of each tile that its points' supports overlap (parallel over tiles).
   if (tile_shift_ == block_shift_) {
     // A tile is one block, and every tile has a point.
-    block_masks_.assign(tiles_.size(), 1);
+    plan.block_masks.assign(plan.tiles.size(), 1);
     return;
   }
-  block_masks_.assign(tiles_.size() * mask_words_, 0);
-  tbb::parallel_for(std::size_t{0}, tiles_.size(), [&](std::size_t t) { mark_blocks(t); });
+  plan.block_masks.assign(plan.tiles.size() * mask_words_, 0);
+  tbb::parallel_for(std::size_t{0}, plan.tiles.size(),
+                    [&](std::size_t t) { mark_blocks(t, plan); });
 }
 
-bool TileInserter::number_few_tiles(std::size_t pairs) {
-  tiles_.clear();
-  pair_tile_ids_.resize(pairs);
+bool TileInserter::number_few_tiles(std::size_t pairs, TilePlan& plan) const {
+  plan.tiles.clear();
+  plan.pair_tile_ids.resize(pairs);
   std::uint32_t last = 0;
   for (std::size_t j = 0; j < pairs; ++j) {
-    const BlockIndex& tile = pair_tiles_[j];
-    if (tiles_.empty() || !(tiles_[last] == tile)) {
+    const BlockIndex& tile = plan.pair_tiles[j];
+    if (plan.tiles.empty() || !(plan.tiles[last] == tile)) {
       std::size_t id = 0;
-      while (id < tiles_.size() && !(tiles_[id] == tile)) ++id;
-      if (id == tiles_.size()) {
+      while (id < plan.tiles.size() && !(plan.tiles[id] == tile)) ++id;
+      if (id == plan.tiles.size()) {
         if (id == kFewTiles) return false;
-        tiles_.push_back(tile);
+        plan.tiles.push_back(tile);
       }
       last = static_cast<std::uint32_t>(id);
     }
-    pair_tile_ids_[j] = last;
+    plan.pair_tile_ids[j] = last;
   }
   return true;
 }
 
-void TileInserter::mark_blocks(std::size_t tile) {
+void TileInserter::mark_blocks(std::size_t tile, TilePlan& plan) const {
   const std::int32_t ts = tile_shift_;
   const std::int32_t bs = block_shift_;
   const std::int32_t t_side = blocks_per_tile_side_;
-  const std::array<std::int32_t, 3> t{tiles_[tile].x, tiles_[tile].y, tiles_[tile].z};
-  std::uint64_t* mask = block_masks_.data() + tile * mask_words_;
-  for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
-    const CellBox& box = boxes_[tile_points_[p]];
+  const std::array<std::int32_t, 3> t{plan.tiles[tile].x, plan.tiles[tile].y, plan.tiles[tile].z};
+  std::uint64_t* mask = plan.block_masks.data() + tile * mask_words_;
+  for (std::uint32_t p = plan.tile_offsets[tile]; p < plan.tile_offsets[tile + 1]; ++p) {
+    const CellBox& box = plan.boxes[plan.tile_points[p]];
     // Blocks of this tile that the support overlaps, in tile-local block units.
     std::array<std::int32_t, 3> blo{}, bhi{};
     for (int a = 0; a < 3; ++a) {
@@ -312,33 +313,34 @@ void TileInserter::mark_blocks(std::size_t tile) {
   }
 }
 
-void TileInserter::create_blocks(const BlockAt& block_at, TileInsertResult& result) {
+void TileInserter::create_blocks(TilePlan& plan, const BlockAt& block_at,
+                                 TileInsertResult& result) const {
   const std::int32_t t_side = blocks_per_tile_side_;
   const std::int32_t per_tile = tile_shift_ - block_shift_;
-  block_offsets_.assign(tiles_.size() + 1, 0);
-  tile_blocks_.clear();
-  for (std::size_t t = 0; t < tiles_.size(); ++t) {
-    const std::uint64_t* mask = block_masks_.data() + t * mask_words_;
+  plan.block_offsets.assign(plan.tiles.size() + 1, 0);
+  plan.tile_blocks.clear();
+  for (std::size_t t = 0; t < plan.tiles.size(); ++t) {
+    const std::uint64_t* mask = plan.block_masks.data() + t * mask_words_;
     for (std::size_t w = 0; w < mask_words_; ++w) {
       for (std::uint64_t bits = mask[w]; bits != 0; bits &= bits - 1) {
         const auto local = static_cast<std::int32_t>(w * 64) + std::countr_zero(bits);
-        const BlockIndex index{(tiles_[t].x << per_tile) + local % t_side,
-                               (tiles_[t].y << per_tile) + (local / t_side) % t_side,
-                               (tiles_[t].z << per_tile) + local / (t_side * t_side)};
-        tile_blocks_.push_back({static_cast<std::uint32_t>(local), &block_at(index)});
+        const BlockIndex index{(plan.tiles[t].x << per_tile) + local % t_side,
+                               (plan.tiles[t].y << per_tile) + (local / t_side) % t_side,
+                               (plan.tiles[t].z << per_tile) + local / (t_side * t_side)};
+        plan.tile_blocks.push_back({static_cast<std::uint32_t>(local), &block_at(index)});
         result.updated_blocks.push_back(index);
       }
     }
-    block_offsets_[t + 1] = static_cast<std::uint32_t>(tile_blocks_.size());
+    plan.block_offsets[t + 1] = static_cast<std::uint32_t>(plan.tile_blocks.size());
   }
 }
 
-inline TileInserter::Piece TileInserter::piece_of(std::size_t i,
-                                                  const std::array<std::int32_t, 3>& base) const {
+inline Piece TileInserter::piece_of(const TilePlan& plan, std::size_t i,
+                                    const std::array<std::int32_t, 3>& base) const {
   const std::int32_t side = 1 << tile_shift_;
-  const CellBox& support = boxes_[i];
+  const CellBox& support = plan.boxes[i];
   Piece piece{};
-  const float* first = distances_.data() + i * 3 * width_;
+  const float* first = plan.distances.data() + i * 3 * width_;
   for (int a = 0; a < 3; ++a) {
     piece.box.lo[a] = std::max(support.lo[a], base[a]) - base[a];
     piece.box.hi[a] = std::min(support.hi[a], base[a] + side - 1) - base[a];
@@ -347,14 +349,14 @@ inline TileInserter::Piece TileInserter::piece_of(std::size_t i,
   return piece;
 }
 
-void TileInserter::scatter_in_place(Block& block, const std::array<std::int32_t, 3>& base,
-                                    std::size_t i, const TrainingSet& training,
-                                    const KernelTable& kernel) const {
+void TileInserter::scatter_in_place(const TilePlan& plan, Block& block,
+                                    const std::array<std::int32_t, 3>& base, std::size_t i,
+                                    const TrainingSet& training, const KernelTable& kernel) const {
   const std::int32_t side = 1 << tile_shift_;
   const auto k = static_cast<std::size_t>(params_.num_classes);
   if (params_.method == Method::kCsm) {
     // The support is the point's cell, inside this block.
-    const CellBox& cell_box = boxes_[i];
+    const CellBox& cell_box = plan.boxes[i];
     const int cell =
         block.cell_of(cell_box.lo[0] - base[0], cell_box.lo[1] - base[1], cell_box.lo[2] - base[2]);
     float* alpha = block.cell_evidence_mutable(cell);
@@ -367,7 +369,7 @@ void TileInserter::scatter_in_place(Block& block, const std::array<std::int32_t,
     block.mark_observed(cell);
     return;
   }
-  const Piece piece = piece_of(i, base);
+  const Piece piece = piece_of(plan, i, base);
   const CellBox& box = piece.box;
   if (training.labels[i] >= 0) {
     smooth_point<false>(block, side, box, piece.d2, training, i, kernel);
@@ -376,71 +378,85 @@ void TileInserter::scatter_in_place(Block& block, const std::array<std::int32_t,
   }
 }
 
-void TileInserter::write_back(PlaneTile& scratch, std::size_t tile) const {
+void TileInserter::write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile) const {
   const std::int32_t n = 1 << block_shift_;
   const std::int32_t t_side = blocks_per_tile_side_;
-  for (std::uint32_t j = block_offsets_[tile]; j < block_offsets_[tile + 1]; ++j) {
-    const auto local = static_cast<std::int32_t>(tile_blocks_[j].local);
+  for (std::uint32_t j = plan.block_offsets[tile]; j < plan.block_offsets[tile + 1]; ++j) {
+    const auto local = static_cast<std::int32_t>(plan.tile_blocks[j].local);
     scratch.flush_block(
         {(local % t_side) * n, ((local / t_side) % t_side) * n, (local / (t_side * t_side)) * n},
-        *tile_blocks_[j].block);
+        *plan.tile_blocks[j].block);
   }
   scratch.clear_marks();
 }
 
-void TileInserter::process_tile(std::size_t tile, const TrainingSet& training,
+void TileInserter::process_tile(const TilePlan& plan, std::size_t tile, const TrainingSet& training,
                                 const KernelTable& kernel) {
-  const std::array<std::int32_t, 3> base{
-      tiles_[tile].x << tile_shift_, tiles_[tile].y << tile_shift_, tiles_[tile].z << tile_shift_};
+  const std::array<std::int32_t, 3> base{plan.tiles[tile].x << tile_shift_,
+                                         plan.tiles[tile].y << tile_shift_,
+                                         plan.tiles[tile].z << tile_shift_};
   if (tile_shift_ == block_shift_) {
     // The tile is one block: write into it directly, in the same order as the scratch would.
-    Block& block = *tile_blocks_[block_offsets_[tile]].block;
-    for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
-      scatter_in_place(block, base, tile_points_[p], training, kernel);
+    Block& block = *plan.tile_blocks[plan.block_offsets[tile]].block;
+    for (std::uint32_t p = plan.tile_offsets[tile]; p < plan.tile_offsets[tile + 1]; ++p) {
+      scatter_in_place(plan, block, base, plan.tile_points[p], training, kernel);
     }
     return;
   }
   const auto k = static_cast<std::size_t>(params_.num_classes);
   PlaneTile& scratch = scratch_.local();
-  for (std::uint32_t p = tile_offsets_[tile]; p < tile_offsets_[tile + 1]; ++p) {
-    const std::uint32_t i = tile_points_[p];
-    const Piece piece = piece_of(i, base);
+  for (std::uint32_t p = plan.tile_offsets[tile]; p < plan.tile_offsets[tile + 1]; ++p) {
+    const std::uint32_t i = plan.tile_points[p];
+    const Piece piece = piece_of(plan, i, base);
     const std::int32_t label = training.labels[i];
     scratch.add(piece.box, piece.d2, label,
                 label >= 0 ? nullptr : training.probabilities.data() + i * k, polynomial_);
   }
-  write_back(scratch, tile);
+  write_back(plan, scratch, tile);
+}
+
+void TileInserter::plan(const TrainingSet& training, TilePlan& plan) const {
+  PhaseClock clock;
+  prepare_points(training, plan);
+  plan.rejected_points = static_cast<std::size_t>(std::count(plan.bad.begin(), plan.bad.end(), 1));
+  plan.phases.prepare = clock.lap();
+  group_by_tile(training.size(), plan);
+  // Scratch tiles are big, uneven units of work: the busiest go first so that the last ones
+  // to finish are small (the order cannot change results, tiles are independent).
+  plan.order.resize(plan.tiles.size());
+  std::iota(plan.order.begin(), plan.order.end(), std::uint32_t{0});
+  if (tile_shift_ != block_shift_) {
+    std::stable_sort(plan.order.begin(), plan.order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return plan.tile_offsets[a + 1] - plan.tile_offsets[a] >
+             plan.tile_offsets[b + 1] - plan.tile_offsets[b];
+    });
+  }
+  plan.phases.group = clock.lap();
 }
 
 TileInsertResult TileInserter::insert(const TrainingSet& training, const KernelTable& kernel,
                                       const BlockAt& block_at) {
+  plan(training, plan_);
+  return apply(plan_, training, kernel, block_at);
+}
+
+TileInsertResult TileInserter::apply(TilePlan& plan, const TrainingSet& training,
+                                     const KernelTable& kernel, const BlockAt& block_at) {
   TileInsertResult result;
+  result.rejected_points = plan.rejected_points;
+  result.phases = plan.phases;
   PhaseClock clock;
-  prepare_points(training);
-  result.rejected_points = static_cast<std::size_t>(std::count(bad_.begin(), bad_.end(), 1));
-  result.phases.prepare = clock.lap();
-  group_by_tile(training.size());
-  result.phases.group = clock.lap();
   // Creating blocks mutates the map's table, so it happens before the parallel part.
-  create_blocks(block_at, result);
+  create_blocks(plan, block_at, result);
   result.phases.blocks = clock.lap();
-  // Scratch tiles are big, uneven units of work: the busiest go first so that the last ones
-  // to finish are small (the order cannot change results, tiles are independent). Blocks
-  // written in place are small (S-CSM: a few points each) and go in groups of
+  // Blocks written in place are small (S-CSM: a few points each) and go in groups of
   // kBlocksPerTask to keep the task overhead down.
   const bool in_place = tile_shift_ == block_shift_;
-  order_.resize(tiles_.size());
-  std::iota(order_.begin(), order_.end(), std::uint32_t{0});
-  if (!in_place) {
-    std::stable_sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return tile_offsets_[a + 1] - tile_offsets_[a] > tile_offsets_[b + 1] - tile_offsets_[b];
-    });
-  }
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, tiles_.size(), in_place ? kBlocksPerTask : 1),
+      tbb::blocked_range<std::size_t>(0, plan.tiles.size(), in_place ? kBlocksPerTask : 1),
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
-          process_tile(order_[t], training, kernel);
+          process_tile(plan, plan.order[t], training, kernel);
         }
       },
       tbb::simple_partitioner());

@@ -38,6 +38,42 @@ struct TileInsertResult {
   InsertPhases phases;  // all but `training`
 };
 
+// A point's support clipped to a tile, in tile-local cells, and its squared per-axis
+// distances from the clipped box's first cell on.
+struct Piece {
+  CellBox box;
+  std::array<const float*, 3> d2;
+};
+// A block of a tile: its position inside the tile (x fastest) and the block itself.
+struct TileBlock {
+  std::uint32_t local;
+  Block* block;
+};
+
+// Everything one scan's insertion needs that does not depend on the map: the points'
+// supports and distances and their grouping into tiles (TileInserter::plan), plus the tiles'
+// blocks once they exist (TileInserter::apply). Kept across scans to reuse the buffers.
+struct TilePlan {
+  std::vector<CellBox> boxes;     // support of each training point (empty if unusable)
+  std::vector<float> distances;   // S-BKI: squared axis distances, 3 * width_ per point
+  std::vector<std::uint8_t> bad;  // 1 for rejected points
+  std::size_t rejected_points = 0;
+  std::vector<std::uint32_t> pair_first;  // count + 1: first (point, tile) pair of each point
+  std::vector<BlockIndex> pair_tiles;
+  std::vector<std::uint32_t> pair_points;
+  VoxelGrouping tile_grouping;
+  std::vector<std::uint32_t> pair_tile_ids;  // per pair: its tile's number
+  std::vector<BlockIndex> tiles;
+  std::vector<std::uint32_t> tile_offsets;  // tiles.size() + 1, into tile_points
+  std::vector<std::uint32_t> tile_points;
+  std::vector<std::uint64_t> block_masks;  // mask_words_ per tile
+  std::vector<std::uint32_t> fill;
+  std::vector<std::uint32_t> order;          // tiles in processing order
+  std::vector<std::uint32_t> block_offsets;  // tiles.size() + 1, into tile_blocks (apply)
+  std::vector<TileBlock> tile_blocks;
+  InsertPhases phases;  // prepare and group
+};
+
 // A tile is a cube of cells, the unit of parallel work: 32 cells per side (16 when such a
 // scratch tile of K classes would exceed 512 KiB), or exactly one block when blocks have 8 or
 // more cells per side, and for S-CSM. A toy training point's support (6 cells wide) reaches
@@ -55,37 +91,34 @@ class TileInserter {
 
   explicit TileInserter(const MapParams& params);
 
-  // Fuses `training`; points with a bad label or unmappable coordinates are rejected and
-  // counted. `block_at` returns the block at an index, creating it; it is called serially
-  // before the parallel part.
+  // Fuses `training`: plan() then apply(). Points with a bad label or unmappable coordinates
+  // are rejected and counted. `block_at` returns the block at an index, creating it; it is
+  // called serially before the parallel part.
   TileInsertResult insert(const TrainingSet& training, const KernelTable& kernel,
                           const BlockAt& block_at);
+  // The map-independent part of insert: may run for a later scan (any number at once, each
+  // with its own plan) while apply() fuses an earlier one.
+  void plan(const TrainingSet& training, TilePlan& plan) const;
+  // Creates the plan's missing blocks and adds the training set's weights to the map.
+  TileInsertResult apply(TilePlan& plan, const TrainingSet& training, const KernelTable& kernel,
+                         const BlockAt& block_at);
 
  private:
-  // A point's support clipped to a tile, in tile-local cells, and its squared per-axis
-  // distances from the clipped box's first cell on.
-  struct Piece {
-    CellBox box;
-    std::array<const float*, 3> d2;
-  };
-  // A block of a tile: its position inside the tile (x fastest) and the block itself.
-  struct TileBlock {
-    std::uint32_t local;
-    Block* block;
-  };
-
-  void prepare_points(const TrainingSet& training);
-  void group_by_tile(std::size_t count);
-  // Numbers the pairs' tiles by first occurrence (tiles_, pair_tile_ids_) with a linear
+  void prepare_points(const TrainingSet& training, TilePlan& plan) const;
+  void group_by_tile(std::size_t count, TilePlan& plan) const;
+  // Numbers the pairs' tiles by first occurrence (tiles, pair_tile_ids) with a linear
   // list; false when more than kFewTiles distinct tiles appear (then nothing is numbered).
-  bool number_few_tiles(std::size_t pairs);
-  void mark_blocks(std::size_t tile);
-  void create_blocks(const BlockAt& block_at, TileInsertResult& result);
-  void process_tile(std::size_t tile, const TrainingSet& training, const KernelTable& kernel);
-  Piece piece_of(std::size_t i, const std::array<std::int32_t, 3>& base) const;
-  void scatter_in_place(Block& block, const std::array<std::int32_t, 3>& base, std::size_t i,
-                        const TrainingSet& training, const KernelTable& kernel) const;
-  void write_back(PlaneTile& scratch, std::size_t tile) const;
+  bool number_few_tiles(std::size_t pairs, TilePlan& plan) const;
+  void mark_blocks(std::size_t tile, TilePlan& plan) const;
+  void create_blocks(TilePlan& plan, const BlockAt& block_at, TileInsertResult& result) const;
+  void process_tile(const TilePlan& plan, std::size_t tile, const TrainingSet& training,
+                    const KernelTable& kernel);
+  Piece piece_of(const TilePlan& plan, std::size_t i,
+                 const std::array<std::int32_t, 3>& base) const;
+  void scatter_in_place(const TilePlan& plan, Block& block, const std::array<std::int32_t, 3>& base,
+                        std::size_t i, const TrainingSet& training,
+                        const KernelTable& kernel) const;
+  void write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile) const;
 
   MapParams params_;
   KernelPolynomial polynomial_;  // the kernel of scratch tiles (blocks written in place: table)
@@ -94,25 +127,9 @@ class TileInserter {
   std::int32_t blocks_per_tile_side_;
   std::size_t mask_words_;  // 64-bit words of a tile's block mask
   std::size_t width_;       // distances stored per point and axis
-
-  // Per-scan buffers, kept across scans to avoid reallocating them.
-  std::vector<CellBox> boxes_;             // support of each training point (empty if unusable)
-  std::vector<float> distances_;           // S-BKI: squared axis distances, 3 * width_ per point
-  std::vector<std::uint8_t> bad_;          // 1 for rejected points
-  std::vector<std::uint32_t> pair_first_;  // count + 1: first (point, tile) pair of each point
-  std::vector<BlockIndex> pair_tiles_;
-  std::vector<std::uint32_t> pair_points_;
   static constexpr std::size_t kFewTiles = 64;
-  VoxelGrouping tile_grouping_;
-  std::vector<std::uint32_t> pair_tile_ids_;  // per pair: its tile's number
-  std::vector<BlockIndex> tiles_;
-  std::vector<std::uint32_t> tile_offsets_;  // tiles_.size() + 1, into tile_points_
-  std::vector<std::uint32_t> tile_points_;
-  std::vector<std::uint64_t> block_masks_;  // mask_words_ per tile
-  std::vector<std::uint32_t> fill_;
-  std::vector<std::uint32_t> block_offsets_;  // tiles_.size() + 1, into tile_blocks_
-  std::vector<TileBlock> tile_blocks_;
-  std::vector<std::uint32_t> order_;                    // tiles in processing order
+
+  TilePlan plan_;                                       // of insert()
   tbb::enumerable_thread_specific<PlaneTile> scratch_;  // created on first use per thread
 };
 

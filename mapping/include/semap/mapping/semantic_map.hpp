@@ -22,6 +22,7 @@ namespace semap::mapping {
 
 namespace detail {
 class TileInserter;
+struct TilePlan;
 }  // namespace detail
 
 struct MapStats {
@@ -74,10 +75,10 @@ class SemanticMap {
   // Inserts clouds[i] seen from origins[i] in order, with the same map and results as calling
   // insert(clouds[i], origins[i]) one after the other, but builds the training sets of the
   // next scans (they do not depend on the map) while the current one is fused: a
-  // tbb::parallel_pipeline whose parallel stage builds training sets and whose serial,
-  // in-order stage fuses them. If a scan's build throws, the scans before it are inserted and
-  // the exception is rethrown, as in the loop. Throws std::invalid_argument when the spans
-  // differ in length.
+  // tbb::parallel_pipeline whose parallel stage builds training sets and groups their points
+  // into tiles, and whose serial, in-order stage creates blocks and fuses them. If a scan's build
+  // throws, the scans before it are inserted and the exception is rethrown, as in the loop. Throws
+  // std::invalid_argument when the spans differ in length.
   std::vector<InsertResult> insert(std::span<const common::LabeledCloud> clouds,
                                    std::span<const Eigen::Vector3f> origins);
   // Fuses a prepared training set: each point adds k(d) y to every cell centre within ell
@@ -117,8 +118,10 @@ class SemanticMap {
 
  private:
   Block& block_at(const BlockIndex& index);
-  // insert(training) plus the training set's own rejected and out-of-range counts.
-  InsertResult insert_built(const TrainingSet& training);
+  // insert(training), with the map-independent part already done when `plan` is given.
+  InsertResult fuse(const TrainingSet& training, detail::TilePlan* plan);
+  // fuse() plus the training set's own rejected and out-of-range counts (scans given as clouds).
+  InsertResult fuse_scan(const TrainingSet& training, detail::TilePlan* plan);
 
   MapParams params_;
   KernelTable kernel_;
