@@ -295,19 +295,29 @@ void TileInserter::group_by_tile(std::size_t count, TilePlan& plan) const {
 bool TileInserter::number_few_tiles(std::size_t pairs, TilePlan& plan) const {
   plan.tiles.clear();
   plan.pair_tile_ids.resize(pairs);
-  std::uint32_t last = 0;
+  // A point's pairs alternate between its 1..8 tiles, so remembering only the last tile sent
+  // most pairs to the list search; a slot per hash of the tile finds nearly all of them.
+  constexpr std::uint32_t kNoTile = 0xFFFFFFFFu;
+  static_assert(kFewTiles == 64, "one slot per 6-bit hash below");
+  std::array<std::uint32_t, kFewTiles> recent;
+  recent.fill(kNoTile);
   for (std::size_t j = 0; j < pairs; ++j) {
     const BlockIndex& tile = plan.pair_tiles[j];
-    if (plan.tiles.empty() || !(plan.tiles[last] == tile)) {
-      std::size_t id = 0;
+    const std::uint32_t slot = (static_cast<std::uint32_t>(tile.x) * 0x9E3779B1u ^
+                                static_cast<std::uint32_t>(tile.y) * 0x85EBCA77u ^
+                                static_cast<std::uint32_t>(tile.z) * 0xC2B2AE3Du) >>
+                               26;
+    std::uint32_t id = recent[slot];
+    if (id == kNoTile || !(plan.tiles[id] == tile)) {
+      id = 0;
       while (id < plan.tiles.size() && !(plan.tiles[id] == tile)) ++id;
       if (id == plan.tiles.size()) {
         if (id == kFewTiles) return false;
         plan.tiles.push_back(tile);
       }
-      last = static_cast<std::uint32_t>(id);
+      recent[slot] = id;
     }
-    plan.pair_tile_ids[j] = last;
+    plan.pair_tile_ids[j] = id;
   }
   return true;
 }
@@ -330,6 +340,14 @@ void TileInserter::mark_blocks(std::size_t tile, TilePlan& plan) const {
     }
     const std::uint64_t xbits =
         ((std::uint64_t{2} << bhi[0]) - 1) & ~((std::uint64_t{1} << blo[0]) - 1);
+    if (t_side == 8) {
+      // One word per z-slice of 8 x 8 blocks (toy: 32-cell tiles of 4-cell blocks): the
+      // rows blo[1]..bhi[1] get xbits each, one multiplication (xbits < 2^8, no carries).
+      constexpr std::uint64_t kRowStarts = 0x0101010101010101ull;
+      const std::uint64_t rows = (kRowStarts >> (8 * (7 - (bhi[1] - blo[1])))) << (8 * blo[1]);
+      for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) mask[bz] |= xbits * rows;
+      continue;
+    }
     for (std::int32_t bz = blo[2]; bz <= bhi[2]; ++bz) {
       for (std::int32_t by = blo[1]; by <= bhi[1]; ++by) {
         // A row of t_side <= 16 bits starts at a multiple of t_side: one word.
