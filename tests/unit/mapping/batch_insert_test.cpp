@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <cstring>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -79,6 +80,9 @@ TEST_P(BatchInsert, EqualsOneByOneInsertionOnOneAndTwoThreads) {
       EXPECT_EQ(results[i].out_of_range, expected[i].out_of_range);
       EXPECT_EQ(results[i].rejected_points, expected[i].rejected_points);
       EXPECT_EQ(results[i].updated_blocks, expected[i].updated_blocks);
+      // Each scan's own build and scatter are timed (a scan of ~3.4k points takes > 1 us).
+      EXPECT_GT(results[i].phases.training, 0.0);
+      EXPECT_GT(results[i].phases.scatter, 0.0);
     }
   }
 }
@@ -96,6 +100,15 @@ TEST(BatchInsert, ABadScanLeavesTheScansBeforeItInsertedAndThrows) {
   tbb::task_arena(2).execute(
       [&] { EXPECT_THROW(batch.insert(scans, origins), std::invalid_argument); });
   expect_identical(first_two, batch);
+}
+
+TEST(BatchInsert, AnEmptyBatchLeavesTheMapEmpty) {
+  SemanticMap map(params_for(Method::kBki));
+  EXPECT_TRUE(
+      map.insert(std::span<const common::LabeledCloud>{}, std::span<const Eigen::Vector3f>{})
+          .empty());
+  EXPECT_EQ(map.stats().scans, 0u);
+  EXPECT_EQ(map.stats().blocks, 0u);
 }
 
 TEST(BatchInsert, RejectsAnOriginCountThatDiffersFromTheScans) {
