@@ -74,10 +74,13 @@ std::int32_t tile_shift_for(const MapParams& params) {
   return big <= kScratchBytes ? 5 : 4;
 }
 
-// Squared distances stored per point and axis: at least the widest support (2 ell / res + 1
-// cells; 2 more for rounding), a multiple of 8 so that axis_distances may write whole vectors.
+// Squared distances stored per point and axis: at least the widest support, a multiple of 8
+// so that axis_distances may write whole vectors. A support spans 2 ell / res cells plus the
+// rounding of its two float end points (well under one cell together inside the mappable
+// range), so it has at most floor(2 ell / res) + 2 cells. No more than that: the toy's 8
+// instead of 16 floats per axis took its two-thread batch insert from 5.50 to 5.00 ms.
 std::size_t distances_per_axis(const MapParams& params) {
-  const auto widest = static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 3;
+  const auto widest = static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 2;
   return (widest + 7) / 8 * 8;
 }
 
