@@ -22,15 +22,26 @@ namespace {
 // Cells a training point touches: for S-BKI all cells whose centre lies within ell per
 // axis (rows are trimmed to the sphere in the scatter loop), for S-CSM the cell containing
 // the point.
-CellBox support_of(const Eigen::Vector3f& p, const MapParams& params) {
-  const float inv_res = 1.0f / params.resolution;
+// What support_of needs from the parameters, copied into the per-point loop: there, stores
+// into the plan's arrays could alias MapParams' fields and would force a reload per point.
+struct SupportRule {
+  bool csm;
+  float ell;
+  float inv_res;
+};
+
+SupportRule support_rule(const MapParams& params) {
+  return {params.method == Method::kCsm, params.ell, 1.0f / params.resolution};
+}
+
+CellBox support_of(const Eigen::Vector3f& p, const SupportRule& rule) {
   CellBox box{};
   for (int a = 0; a < 3; ++a) {
-    if (params.method == Method::kCsm) {
-      box.lo[a] = box.hi[a] = fast_floor(p[a] * inv_res);
+    if (rule.csm) {
+      box.lo[a] = box.hi[a] = fast_floor(p[a] * rule.inv_res);
     } else {
-      box.lo[a] = fast_ceil((p[a] - params.ell) * inv_res - 0.5f);
-      box.hi[a] = fast_floor((p[a] + params.ell) * inv_res - 0.5f);
+      box.lo[a] = fast_ceil((p[a] - rule.ell) * rule.inv_res - 0.5f);
+      box.hi[a] = fast_floor((p[a] + rule.ell) * rule.inv_res - 0.5f);
     }
   }
   return box;
@@ -194,30 +205,39 @@ void TileInserter::prepare_points(const TrainingSet& training, TilePlan& plan) c
   plan.bad.resize(count);
   // Padded so that the row test may read 8 floats from any cell of the last point.
   plan.distances.resize(count * 3 * width_ + 8);
-  const float inv_res = 1.0f / params_.resolution;
+  // Locals and raw pointers: the loop's stores would otherwise make the compiler reload the
+  // members and vector pointers they might alias for every point.
+  const SupportRule rule = support_rule(params_);
   const float resolution = params_.resolution;
+  const std::int32_t classes = params_.num_classes;
+  const std::size_t width = width_;
   const std::size_t soft_rows = training.probabilities.size() / params_.num_classes;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, count, kPointGrain),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          const std::int32_t label = training.labels[i];
-          const bool label_ok = label >= 0 ? label < params_.num_classes : i < soft_rows;
-          if (!label_ok || !mappable(training.points[i], inv_res)) {
-            plan.bad[i] = 1;
-            plan.boxes[i] = kEmptyBox;
-            continue;
-          }
-          plan.bad[i] = 0;
-          const CellBox box = support_of(training.points[i], params_);
-          plan.boxes[i] = box;
-          if (width_ == 0) continue;
-          float* d2 = plan.distances.data() + i * 3 * width_;
-          for (int a = 0; a < 3; ++a, d2 += width_) {
-            axis_distances(box.lo[a], box.hi[a], training.points[i][a], resolution, d2);
-          }
-        }
-      });
+  const Eigen::Vector3f* points = training.points.data();
+  const std::int32_t* labels = training.labels.data();
+  CellBox* boxes = plan.boxes.data();
+  std::uint8_t* bad = plan.bad.data();
+  float* distances = plan.distances.data();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kPointGrain),
+                    [=](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const std::int32_t label = labels[i];
+                        const bool label_ok = label >= 0 ? label < classes : i < soft_rows;
+                        const Eigen::Vector3f p = points[i];
+                        if (!label_ok || !mappable(p, rule.inv_res)) {
+                          bad[i] = 1;
+                          boxes[i] = kEmptyBox;
+                          continue;
+                        }
+                        bad[i] = 0;
+                        const CellBox box = support_of(p, rule);
+                        boxes[i] = box;
+                        if (width == 0) continue;
+                        float* d2 = distances + i * 3 * width;
+                        for (int a = 0; a < 3; ++a, d2 += width) {
+                          axis_distances(box.lo[a], box.hi[a], p[a], resolution, d2);
+                        }
+                      }
+                    });
 }
 
 void TileInserter::group_by_tile(std::size_t count, TilePlan& plan) const {
