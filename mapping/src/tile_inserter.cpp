@@ -222,7 +222,7 @@ void TileInserter::prepare_points(const TrainingSet& training, TilePlan& plan) c
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
                         const std::int32_t label = labels[i];
                         const bool label_ok = label >= 0 ? label < classes : i < soft_rows;
-                        const Eigen::Vector3f p = points[i];
+                        const Eigen::Vector3f& p = points[i];
                         if (!label_ok || !mappable(p, rule.inv_res)) {
                           bad[i] = 1;
                           boxes[i] = kEmptyBox;
