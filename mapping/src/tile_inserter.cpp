@@ -36,13 +36,13 @@ SupportRule support_rule(const MapParams& params) {
 
 CellBox support_of(const Eigen::Vector3f& p, const SupportRule& rule) {
   CellBox box{};
+  if (rule.csm) {
+    for (int a = 0; a < 3; ++a) box.lo[a] = box.hi[a] = fast_floor(p[a] * rule.inv_res);
+    return box;
+  }
   for (int a = 0; a < 3; ++a) {
-    if (rule.csm) {
-      box.lo[a] = box.hi[a] = fast_floor(p[a] * rule.inv_res);
-    } else {
-      box.lo[a] = fast_ceil((p[a] - rule.ell) * rule.inv_res - 0.5f);
-      box.hi[a] = fast_floor((p[a] + rule.ell) * rule.inv_res - 0.5f);
-    }
+    box.lo[a] = fast_ceil((p[a] - rule.ell) * rule.inv_res - 0.5f);
+    box.hi[a] = fast_floor((p[a] + rule.ell) * rule.inv_res - 0.5f);
   }
   return box;
 }
