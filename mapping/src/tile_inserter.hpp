@@ -55,7 +55,7 @@ struct TileBlock {
 // blocks once they exist (TileInserter::apply). Kept across scans to reuse the buffers.
 struct TilePlan {
   std::vector<CellBox> boxes;     // support of each training point (empty if unusable)
-  std::vector<float> distances;   // S-BKI: squared axis distances, 3 * width_ per point
+  std::vector<float> distances;   // blocks in place: squared axis distances, 3 * width_ per point
   std::vector<std::uint8_t> bad;  // 1 for rejected points
   std::size_t rejected_points = 0;
   std::vector<std::uint32_t> pair_first;  // count + 1: first (point, tile) pair of each point
