@@ -9,22 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "semap/mapping/pcd_io.hpp"
 #include "semap/mapping/semantic_map.hpp"
+#include "toy_dataset.hpp"
 
 namespace semap::mapping {
 namespace {
 
-std::vector<common::LabeledCloud> toy_scans(int count) {
-  std::vector<common::LabeledCloud> scans;
-  for (int i = 1; i <= count; ++i) {
-    scans.push_back(read_pcd(std::string(SEMAP_SHARED_DATA_DIR) +
-                             "/sim_unstructured_annotated/sim_unstructured_annotated_" +
-                             std::to_string(i) + ".pcd")
-                        .cloud);
-  }
-  return scans;
-}
+std::vector<common::LabeledCloud> toy_scans(int count) { return testing::toy_scans(1, count); }
 
 std::vector<Eigen::Vector3f> origins_of(const std::vector<common::LabeledCloud>& scans) {
   std::vector<Eigen::Vector3f> origins;

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "semap/mapping/label_noise.hpp"
-#include "semap/mapping/pcd_io.hpp"
+#include "toy_dataset.hpp"
 
 namespace semap::mapping {
 namespace {
@@ -69,13 +69,7 @@ TEST(Evaluation, BkiFillsTheGapBetweenSparseHitsThatCsmLeavesUnknown) {
 }
 
 TEST(Evaluation, BkiBeatsCsmOnTheToyDatasetAtEveryNoiseLevel) {
-  std::vector<common::LabeledCloud> scans;
-  for (int i = 1; i <= 12; ++i) {
-    scans.push_back(read_pcd(std::string(SEMAP_SHARED_DATA_DIR) +
-                             "/sim_unstructured_annotated/sim_unstructured_annotated_" +
-                             std::to_string(i) + ".pcd")
-                        .cloud);
-  }
+  const std::vector<common::LabeledCloud> scans = testing::toy_scans(1, 12);
   const std::vector<double> noise{0.0, 0.3, 0.5};
   const auto rows = evaluate_label_noise(scans, MapParams{}, noise, 1);
   ASSERT_EQ(rows.size(), 6u);

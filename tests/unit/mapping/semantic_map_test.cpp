@@ -9,7 +9,7 @@
 #include <random>
 #include <tuple>
 
-#include "semap/mapping/pcd_io.hpp"
+#include "toy_dataset.hpp"
 
 namespace semap::mapping {
 namespace {
@@ -166,16 +166,7 @@ TEST(SemanticMap, TwoClassCsmIsTheBinaryCountingSensorModel) {
   EXPECT_EQ(cell->state(), CellState::kOccupied);
 }
 
-std::vector<common::LabeledCloud> toy_scans(int count) {
-  std::vector<common::LabeledCloud> scans;
-  for (int i = 1; i <= count; ++i) {
-    scans.push_back(read_pcd(std::string(SEMAP_SHARED_DATA_DIR) +
-                             "/sim_unstructured_annotated/sim_unstructured_annotated_" +
-                             std::to_string(i) + ".pcd")
-                        .cloud);
-  }
-  return scans;
-}
+std::vector<common::LabeledCloud> toy_scans(int count) { return testing::toy_scans(1, count); }
 
 SemanticMap build_with_threads(const std::vector<common::LabeledCloud>& scans, Method method,
                                int threads) {
