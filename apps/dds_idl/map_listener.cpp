@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   std::size_t expect_blocks = 0;
   int num_classes = 0;
   bool health = false;
+  bool take_on_receive = false;
   app.add_option("--config", config_path, "semap YAML; its dds: section is used")
       ->check(CLI::ExistingFile);
   app.add_option("--save", save_path, "write the received map as PCD (x y z class variance)");
@@ -50,6 +51,8 @@ int main(int argc, char** argv) {
   app.add_option("--expect-blocks", expect_blocks, "stop once this many blocks arrived");
   app.add_option("--classes", num_classes, "reject blocks with another class count");
   app.add_flag("--health", health, "also print the robot's health reports");
+  app.add_flag("--take-on-receive", take_on_receive,
+               "take blocks on Cyclone's receive thread instead of this one");
   CLI11_PARSE(app, argc, argv);
   semap::common::setup_logging();
 
@@ -63,6 +66,7 @@ int main(int argc, char** argv) {
     sd::MapClientConfig cfg;
     cfg.ns = dds.settings().ns;
     cfg.limits.num_classes = static_cast<std::uint16_t>(num_classes);
+    cfg.take_on_receive = take_on_receive;
     sd::MapClient client(participant, cfg);
     sd::Topic<sd::msg::Odometry> odom_topic(
         participant, sd::topic_name(dds.settings().ns, sd::SemapTopic::kOdometry));
@@ -93,17 +97,18 @@ int main(int argc, char** argv) {
         });
       }
       const auto now = std::chrono::steady_clock::now();
-      if (client.counters().infos != info_seen && client.info()) {
+      const std::optional<sd::MapDescription> info = client.info();
+      if (client.counters().infos != info_seen && info) {
         info_seen = client.counters().infos;
-        const auto& i = *client.info();
+        const sd::MapDescription& i = *info;
         std::cout << "map_info: resolution " << i.resolution << " m, " << i.block_cells
                   << "^3 cells/block, " << i.num_classes << " classes, " << i.num_blocks
                   << " blocks, sequence " << i.sequence << std::endl;
       }
       if (now >= next_report) {
-        const auto& c = client.counters();
-        std::cout << "blocks " << client.blocks().size() << " accepted " << c.accepted
-                  << " rejected " << c.rejected_total() << " stale " << c.stale;
+        const sd::MapClientCounters c = client.counters();
+        std::cout << "blocks " << client.block_count() << " accepted " << c.accepted << " rejected "
+                  << c.rejected_total() << " stale " << c.stale;
         if (last_pose) {
           std::cout << " pose " << last_pose->position.transpose();
         }
@@ -112,10 +117,10 @@ int main(int argc, char** argv) {
           std::cout << "  last error: " << client.last_error() << std::endl;
         next_report = now + std::chrono::seconds(1);
       }
-      if (expect_blocks > 0 && client.blocks().size() >= expect_blocks) break;
+      if (expect_blocks > 0 && client.block_count() >= expect_blocks) break;
       if (seconds > 0 && now - start > std::chrono::duration<double>(seconds)) break;
     }
-    std::cout << "final: blocks " << client.blocks().size() << " accepted "
+    std::cout << "final: blocks " << client.block_count() << " accepted "
               << client.counters().accepted << " rejected " << client.counters().rejected_total()
               << std::endl;
     if (!save_path.empty()) {

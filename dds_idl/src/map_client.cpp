@@ -14,20 +14,62 @@ std::uint64_t MapClientCounters::rejected_total() const {
   return std::accumulate(rejected.begin(), rejected.end(), std::uint64_t{0});
 }
 
+namespace {
+
+using ListenerPtr = std::unique_ptr<dds_listener_t, decltype(&dds_delete_listener)>;
+
+// The listener is copied by Cyclone when the reader is created; null: no listener.
+ListenerPtr block_listener(void* client, bool take_on_receive, dds_on_data_available_fn fn) {
+  ListenerPtr l(take_on_receive ? dds_create_listener(client) : nullptr, &dds_delete_listener);
+  if (l) dds_lset_data_available(l.get(), fn);
+  return l;
+}
+
+}  // namespace
+
 MapClient::MapClient(const Participant& participant, MapClientConfig config)
     : config_(std::move(config)),
       block_topic_(participant, topic_name(config_.ns, SemapTopic::kMapBlocks)),
-      block_reader_(participant, block_topic_, topic_qos(SemapTopic::kMapBlocks)),
+      block_reader_(participant, block_topic_, topic_qos(SemapTopic::kMapBlocks),
+                    block_listener(this, config_.take_on_receive, &on_data_available).get()),
       info_topic_(participant, topic_name(config_.ns, SemapTopic::kMapInfo)),
-      info_reader_(participant, info_topic_, topic_qos(SemapTopic::kMapInfo)) {}
+      info_reader_(participant, info_topic_, topic_qos(SemapTopic::kMapInfo)) {
+  constructed_ = true;
+  // Blocks whose notification came while this was still being built are taken now.
+  if (config_.take_on_receive) on_data_available(block_reader_.handle(), this);
+}
 
-std::size_t MapClient::poll() {
-  // MapInfo first: it may fix the shape the blocks are checked against.
-  info_reader_.take_each([this](const msg::MapInfo& m, const dds_sample_info_t&) { on_info(m); });
-  const std::uint64_t before = counters_.accepted;
+MapClient::~MapClient() {
+  // Returns once a listener call in progress has finished.
+  if (config_.take_on_receive) dds_set_listener(block_reader_.handle(), nullptr);
+}
+
+void MapClient::on_data_available(dds_entity_t, void* self) {
+  auto* client = static_cast<MapClient*>(self);
+  if (!client->constructed_) return;
+  bool wanted = false;
+  {
+    const std::lock_guard lock(client->mutex_);
+    client->take_blocks();
+    wanted = client->blocks_.size() >= client->wait_for_count_;
+  }
+  // Only when a waiter's count is reached: a wake-up per sample would cost the receive thread
+  // as much as taking the sample.
+  if (wanted) client->accepted_cv_.notify_all();
+}
+
+void MapClient::take_blocks() {
   // Serialised blocks, read by read_block_cdr: Cyclone's deserialiser and a copy skipped.
   block_reader_.take_each_cdr(
       [this](std::span<const std::uint8_t> cdr, const dds_sample_info_t&) { on_block(cdr); });
+}
+
+std::size_t MapClient::poll() {
+  const std::lock_guard lock(mutex_);
+  // MapInfo first: it may fix the shape the blocks are checked against.
+  info_reader_.take_each([this](const msg::MapInfo& m, const dds_sample_info_t&) { on_info(m); });
+  const std::uint64_t before = counters_.accepted;
+  take_blocks();
   return static_cast<std::size_t>(counters_.accepted - before);
 }
 
@@ -35,12 +77,47 @@ bool MapClient::wait_for_blocks(std::size_t count, std::chrono::milliseconds tim
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     poll();
-    if (blocks_.size() >= count) return true;
+    if (block_count() >= count) return true;
     const auto now = std::chrono::steady_clock::now();
     if (now >= deadline) return false;
-    block_reader_.wait(
-        std::min<std::chrono::nanoseconds>(deadline - now, std::chrono::milliseconds(50)));
+    // At most 50 ms between polls: MapInfo is taken by poll() only.
+    const auto until = std::min(deadline, now + std::chrono::milliseconds(50));
+    if (config_.take_on_receive) {
+      std::unique_lock lock(mutex_);
+      wait_for_count_ = count;
+      accepted_cv_.wait_until(lock, until, [&] { return blocks_.size() >= count; });
+      wait_for_count_ = SIZE_MAX;
+    } else {
+      block_reader_.wait(until - now);
+    }
   }
+}
+
+const MapClient::BlockMap& MapClient::blocks() const {
+  if (config_.take_on_receive) {
+    throw std::logic_error("MapClient::blocks() with take_on_receive: use with_blocks()");
+  }
+  return blocks_;
+}
+
+std::size_t MapClient::block_count() const {
+  const std::lock_guard lock(mutex_);
+  return blocks_.size();
+}
+
+std::optional<MapDescription> MapClient::info() const {
+  const std::lock_guard lock(mutex_);
+  return info_;
+}
+
+MapClientCounters MapClient::counters() const {
+  const std::lock_guard lock(mutex_);
+  return counters_;
+}
+
+std::string MapClient::last_error() const {
+  const std::lock_guard lock(mutex_);
+  return last_error_;
 }
 
 void MapClient::on_info(const msg::MapInfo& m) {
@@ -94,9 +171,13 @@ void MapClient::on_block(std::span<const std::uint8_t> cdr) {
   ++counters_.accepted;
 }
 
-std::vector<BlockIndex> MapClient::take_changed() { return std::exchange(changed_, {}); }
+std::vector<BlockIndex> MapClient::take_changed() {
+  const std::lock_guard lock(mutex_);
+  return std::exchange(changed_, {});
+}
 
 CellQuery MapClient::query(const Eigen::Vector3f& p) const {
+  const std::lock_guard lock(mutex_);
   const BlockLimits& l = config_.limits;
   if (l.resolution <= 0.0f || l.block_cells == 0) return {};
   const BlockIndex index = block_of(p, l.resolution, l.block_cells);
@@ -108,6 +189,7 @@ CellQuery MapClient::query(const Eigen::Vector3f& p) const {
 }
 
 void MapClient::save_pcd(const std::filesystem::path& path) const {
+  const std::lock_guard lock(mutex_);
   std::size_t n = 0;
   for (const auto& [index, b] : blocks_) {
     for (CellState s : b.state) n += s == CellState::kOccupied;

@@ -81,12 +81,18 @@ TEST_F(DdsTest, KilledAndRestartedListenerRecoversMap) {
   EXPECT_EQ(restarted.wait(), 0);
 }
 
-TEST_F(DdsTest, MalformedBlocksAreRejectedAndCounted) {
+// Both ways of taking blocks: poll() on this thread, or Cyclone's receive thread as they arrive.
+class MapClientTakeModes : public DdsTest, public ::testing::WithParamInterface<bool> {};
+
+INSTANTIATE_TEST_SUITE_P(TakeOnReceive, MapClientTakeModes, ::testing::Bool());
+
+TEST_P(MapClientTakeModes, MalformedBlocksAreRejectedAndCounted) {
   const std::string ns = unique_ns("bad");
   Participant participant(test_domain());
   MapClientConfig cfg;
   cfg.ns = ns;
   cfg.limits.num_classes = 5;
+  cfg.take_on_receive = GetParam();
   MapClient client(participant, cfg);
   ChildProcess bad(peer("bad-pub", {"--ns", ns, "--classes", "5", "--seconds", "20"}));
   ASSERT_TRUE(bad.expect("published 9", seconds(10)));
@@ -94,19 +100,66 @@ TEST_F(DdsTest, MalformedBlocksAreRejectedAndCounted) {
   const auto deadline = std::chrono::steady_clock::now() + seconds(10);
   while (client.counters().accepted + client.counters().rejected_total() < 9 &&
          std::chrono::steady_clock::now() < deadline) {
-    client.wait_for_blocks(100, milliseconds(100));
+    // Taking on receive, nothing on this thread takes: the receive thread must do it.
+    if (cfg.take_on_receive) {
+      std::this_thread::sleep_for(milliseconds(20));
+    } else {
+      client.wait_for_blocks(100, milliseconds(100));
+    }
   }
-  const MapClientCounters& c = client.counters();
+  const MapClientCounters c = client.counters();
   EXPECT_EQ(c.accepted, 2u);
   EXPECT_EQ(c.rejected_for(BlockReject::kClassCount), 1u);
   EXPECT_EQ(c.rejected_for(BlockReject::kNonFinite), 2u);
   EXPECT_EQ(c.rejected_for(BlockReject::kUnknownIndex), 1u);
   EXPECT_EQ(c.rejected_for(BlockReject::kOutOfRange), 2u);
   EXPECT_EQ(c.rejected_for(BlockReject::kShape), 1u);
-  EXPECT_EQ(client.blocks().size(), 2u);
-  EXPECT_TRUE(client.blocks().contains({0, 0, 0}));
-  EXPECT_TRUE(client.blocks().contains({7, 0, 0}));
+  client.with_blocks([](const MapClient::BlockMap& blocks) {
+    EXPECT_EQ(blocks.size(), 2u);
+    EXPECT_TRUE(blocks.contains({0, 0, 0}));
+    EXPECT_TRUE(blocks.contains({7, 0, 0}));
+  });
   EXPECT_FALSE(client.last_error().empty());
+}
+
+TEST_F(DdsTest, ClientTakingOnReceiveAnswersQueriesWhileBlocksArrive) {
+  const std::string ns = unique_ns("onreceive");
+  Participant participant(test_domain());
+  MapClientConfig cfg;
+  cfg.ns = ns;
+  cfg.take_on_receive = true;
+  MapClient client(participant, cfg);
+  EXPECT_THROW(static_cast<void>(client.blocks()), std::logic_error);
+  ChildProcess pub(peer("map-pub", {"--ns", ns, "--blocks", "300", "--classes", "6", "--version",
+                                    "3", "--seconds", "30"}));
+  // Nothing on this thread takes; its queries race with the receive thread writing the map
+  // (TSan checks the locking), and a block, once known, answers with its content.
+  const BlockSnapshot expected = make_block(grid_index(42), 3, 6, false);
+  const auto check_block_42 = [&] {
+    std::size_t answered = 0;
+    for (std::size_t cell = 0; cell < expected.cell_count(); ++cell) {
+      const CellQuery q = client.query(expected.cell_center(cell));
+      if (!q.known_block) continue;
+      EXPECT_EQ(q.cls, expected.argmax_class[cell]);
+      EXPECT_EQ(q.variance, expected.variance[cell]);
+      ++answered;
+    }
+    return answered;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + seconds(15);
+  while (client.block_count() < 300 && std::chrono::steady_clock::now() < deadline) {
+    check_block_42();
+    std::this_thread::sleep_for(milliseconds(1));
+  }
+  ASSERT_EQ(client.block_count(), 300u);
+  EXPECT_EQ(check_block_42(), expected.cell_count());
+  EXPECT_EQ(client.counters().accepted, 300u);
+  EXPECT_EQ(client.take_changed().size(), 300u);
+  client.with_blocks([](const MapClient::BlockMap& blocks) {
+    for (const auto& [index, block] : blocks) {
+      ASSERT_TRUE(same_content(block, make_block(index, 3, 6, false)));
+    }
+  });
 }
 
 TEST_F(DdsTest, PublisherSendsOnlyChangedBlocksAtItsRate) {
