@@ -167,13 +167,15 @@ void MapClient::on_block(std::span<const std::uint8_t> cdr) {
     return;
   }
   std::swap(it->second, scratch_);
-  changed_.push_back(index);
+  changed_.insert(index);
   ++counters_.accepted;
 }
 
 std::vector<BlockIndex> MapClient::take_changed() {
   const std::lock_guard lock(mutex_);
-  return std::exchange(changed_, {});
+  std::vector<BlockIndex> changed(changed_.begin(), changed_.end());
+  changed_.clear();
+  return changed;
 }
 
 CellQuery MapClient::query(const Eigen::Vector3f& p) const {

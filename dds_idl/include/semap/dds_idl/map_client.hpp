@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "semap/dds_idl/block_codec.hpp"
@@ -87,7 +88,7 @@ class MapClient {
   std::optional<MapDescription> info() const;
   MapClientCounters counters() const;
   std::string last_error() const;
-  // Indices of blocks accepted since the last call.
+  // Indices of blocks accepted since the last call, each once, in no particular order.
   std::vector<BlockIndex> take_changed();
 
   // Writes the occupied cells as an ASCII PCD (x y z class variance); throws on I/O errors.
@@ -115,7 +116,9 @@ class MapClient {
   // A received block is read into this, checked, then swapped with its map entry, so that the
   // entry's old buffers take the next block: no allocation per block of a known shape.
   BlockSnapshot scratch_;
-  std::vector<BlockIndex> changed_;
+  // A set: a block changed many times between two take_changed() is listed once, and a client
+  // that never asks holds at most one entry per block.
+  std::unordered_set<BlockIndex, BlockIndexHash> changed_;
   std::optional<MapDescription> info_;
   MapClientCounters counters_;
   std::string last_error_;
