@@ -35,12 +35,19 @@ if(SEMAP_SIMD_ARCH)
   endif()
 endif()
 
-# semap_simd_tuned(TARGET): compiles TARGET's own sources for SEMAP_SIMD_ARCH.
+# semap_simd_tuned(TARGET [CONTRACT_FMA]): compiles TARGET's own sources for SEMAP_SIMD_ARCH.
+# Without CONTRACT_FMA no automatic FMA contraction: results stay bit-identical to the untuned
+# code that tests compare against (Eigen still uses FMA explicitly in its vector kernels).
+# CONTRACT_FMA lets the compiler fuse a * b + c where the target's tests compare with
+# tolerances, not bits.
 function(semap_simd_tuned target)
+  cmake_parse_arguments(arg "CONTRACT_FMA" "" "" ${ARGN})
   if(SEMAP_SIMD_ARCH)
-    # No automatic FMA contraction: results stay bit-identical to the untuned code that tests
-    # compare against (Eigen still uses FMA explicitly in its vector kernels).
-    target_compile_options(${target} PRIVATE -march=${SEMAP_SIMD_ARCH} -ffp-contract=off)
+    if(arg_CONTRACT_FMA)
+      target_compile_options(${target} PRIVATE -march=${SEMAP_SIMD_ARCH} -ffp-contract=fast)
+    else()
+      target_compile_options(${target} PRIVATE -march=${SEMAP_SIMD_ARCH} -ffp-contract=off)
+    endif()
   endif()
 endfunction()
 
