@@ -50,7 +50,13 @@ void MapClient::on_data_available(dds_entity_t, void* self) {
   bool wanted = false;
   {
     const std::lock_guard lock(client->mutex_);
-    client->take_blocks();
+    // Called from Cyclone's C code: nothing may propagate out of here.
+    try {
+      client->take_blocks();
+    } catch (const std::exception& e) {
+      client->last_error_ = e.what();
+      common::logger("dds.map_client")->error("taking blocks on receive: {}", e.what());
+    }
     wanted = client->blocks_.size() >= client->wait_for_count_;
   }
   // Only when a waiter's count is reached: a wake-up per sample would cost the receive thread
