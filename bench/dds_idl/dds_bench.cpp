@@ -10,15 +10,12 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <iostream>
-#include <memory>
-#include <mutex>
 #include <random>
 #include <span>
 #include <sstream>
