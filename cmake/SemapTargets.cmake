@@ -51,7 +51,10 @@ function(semap_simd_tuned target)
   endif()
 endfunction()
 
-foreach(lib common firmware_bridge drivers estimation mapping dds_idl)
+# Every library folder, in dependency order: later folders may link earlier ones, never the
+# reverse.
+set(SEMAP_LIBRARIES common firmware_bridge drivers estimation perception mapping dds_idl)
+foreach(lib IN LISTS SEMAP_LIBRARIES)
   if(SEMAP_ONLY STREQUAL "" OR lib IN_LIST SEMAP_ONLY)
     set(semap_wants_${lib} TRUE)
   else()
@@ -143,7 +146,7 @@ function(semap_add_subfolders dir)
     # Area folders named after a library (`mapping`, `mapping_tools`) are skipped when that
     # library is not built.
     set(skip FALSE)
-    foreach(lib common firmware_bridge drivers estimation mapping dds_idl)
+    foreach(lib IN LISTS SEMAP_LIBRARIES)
       if((sub STREQUAL lib OR sub MATCHES "^${lib}_") AND NOT semap_wants_${lib})
         set(skip TRUE)
       endif()

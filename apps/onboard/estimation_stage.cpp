@@ -9,17 +9,14 @@ namespace semap::onboard {
 
 EstimationStage::EstimationStage(const OnboardConfig& config,
                                  common::SpscRing<common::ImuSample>& imu,
-                                 common::SpscRing<common::GnssFix>& gnss,
-                                 common::SpscRing<mapping::LabeledDepthImage>& images,
-                                 common::SpscRing<common::LabeledCloud>& clouds, PoseSink pose_sink)
+                                 common::SpscRing<common::GnssFix>& gnss, SharedPoseHistory& poses,
+                                 PoseSink pose_sink)
     : config_(config),
       imu_ring_(imu),
       gnss_ring_(gnss),
-      image_ring_(images),
-      cloud_ring_(clouds),
+      poses_(poses),
       pose_sink_(std::move(pose_sink)),
-      estimator_(config.estimator),
-      body_from_optical_(config.camera.body_from_optical()) {}
+      estimator_(config.estimator) {}
 
 EstimationStage::~EstimationStage() { stop(); }
 
@@ -42,7 +39,6 @@ EstimationStageStats EstimationStage::stats() const {
 void EstimationStage::run(std::stop_token stop) {
   while (!stop.stop_requested()) {
     const bool busy = drain_sensors();
-    pose_images();
     publish_pose();
     share_stats();
     if (!busy) std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -67,6 +63,9 @@ bool EstimationStage::drain_sensors() {
       last_imu_ = imu_batch[i];
       estimator_.add_imu(imu_batch[i++]);
       ++local_.imu_samples;
+      if (estimator_.initialised()) {
+        if (auto pose = estimator_.pose_at(estimator_.filter_time())) new_poses_.push_back(*pose);
+      }
     }
   }
   if (n_imu > 0) {
@@ -75,40 +74,11 @@ bool EstimationStage::drain_sensors() {
       imu_latency_.record(common::seconds_between(done, imu_batch[k].stamp));
     }
   }
-  mapping::LabeledDepthImage image;
-  while (image_ring_.try_pop(image)) {
-    pending_images_.push_back(std::move(image));
-    ++local_.images;
+  if (!new_poses_.empty()) {
+    poses_.append(new_poses_);
+    new_poses_.clear();
   }
   return n_imu + n_gnss > 0;
-}
-
-void EstimationStage::pose_images() {
-  // Only the filter time is needed here: estimate() would also form the covariance, which the
-  // InEKF defers until someone reads it.
-  const bool initialised = estimator_.initialised();
-  const common::Stamp newest = estimator_.filter_time();
-  while (!pending_images_.empty()) {
-    auto& image = pending_images_.front();
-    if (initialised && image.stamp > newest) return;  // the filter has not got there yet
-    const auto pose = estimator_.pose_at(image.stamp);
-    if (!pose) {
-      ++local_.images_without_pose;
-      pending_images_.pop_front();
-      continue;
-    }
-    Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
-    world_from_body.linear() = pose->orientation.toRotationMatrix().cast<float>();
-    world_from_body.translation() = pose->position.cast<float>();
-    auto cloud = mapping::back_project(image, config_.camera.intrinsics,
-                                       world_from_body * body_from_optical_, config_.camera.stride,
-                                       config_.camera.max_range);
-    cloud.num_classes = static_cast<std::uint16_t>(config_.map.num_classes);
-    cloud_ring_.try_push(std::move(cloud));
-    image_latency_.record(common::seconds_between(common::Stamp::now(), image.stamp));
-    ++local_.images_posed;
-    pending_images_.pop_front();
-  }
 }
 
 void EstimationStage::publish_pose() {

@@ -1,6 +1,9 @@
-// semap-onboard: the robot's main job. Drivers -> rings -> estimation stage (InEKF, image
-// posing) -> mapping stage (S-BKI) -> DDS. With rig.kind: sim it runs on the built-in
+// semap-onboard: the robot's main job. Drivers -> rings -> estimation stage (InEKF) and
+// perception stage (segmentation, labelled points posed at their stamps) -> mapping stage
+// (S-BKI) -> DDS. With rig.kind: sim it runs on the built-in
 // simulated sensor rig and reports its own accuracy against the simulated truth.
+#include <sys/resource.h>
+
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdio>
@@ -14,13 +17,17 @@
 #include "health_monitor.hpp"
 #include "mapping_stage.hpp"
 #include "onboard_config.hpp"
+#include "perception_stage.hpp"
+#include "segmenter_factory.hpp"
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/drivers/camera_driver.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/drivers/gnss_driver.hpp"
 #include "semap/estimation/geodesy.hpp"
 #include "semap/mapping/semantic_layers.hpp"
 #include "semap/mapping/smap_io.hpp"
+#include "shared_pose_history.hpp"
 #include "sim_rig.hpp"
 
 namespace {
@@ -65,7 +72,8 @@ class LiveAccuracy {
 struct Rings {
   SpscRing<semap::common::ImuSample>& imu;
   SpscRing<semap::common::GnssFix>& gnss;
-  SpscRing<semap::mapping::LabeledDepthImage>& images;
+  SpscRing<semap::common::ImageFrame>& colour;
+  SpscRing<semap::common::ImageFrame>& depth;
   SpscRing<semap::common::LabeledCloud>& clouds;
 };
 
@@ -80,15 +88,14 @@ std::uint64_t drops(const R&... rings) {
 
 std::vector<semap::onboard::StageFigures> stage_figures(
     const Rings& r, const semap::onboard::EstimationStage& estimation,
-    const semap::onboard::MappingStage& mapping, const semap::onboard::DdsOutputs& dds) {
+    const semap::onboard::PerceptionStage* perception, const semap::onboard::MappingStage& mapping,
+    const semap::onboard::DdsOutputs& dds) {
   const auto est = estimation.stats();
   const auto map = mapping.stats();
   const auto out = dds.map_counters();
-  return {
+  std::vector<semap::onboard::StageFigures> figures{
       {"estimation", est.imu_samples, depth(r.imu, r.gnss), drops(r.imu, r.gnss),
        estimation.imu_latency().percentiles()},
-      {"perception", est.images_posed, depth(r.images), drops(r.images),
-       estimation.image_latency().percentiles()},
       {"mapping", map.scans, depth(r.clouds), drops(r.clouds), mapping.latency().percentiles()},
       // Blocks written, blocks waiting for the next round; a "drop" is a round cut short by a
       // slow reader (its blocks stay pending, nothing is lost).
@@ -98,6 +105,16 @@ std::vector<semap::onboard::StageFigures> stage_figures(
        out.write_timeouts,
        {}},
   };
+  if (perception) {
+    // Frames lost anywhere before the map: in the driver's ring, passed over, unpaired,
+    // unreadable or without a pose.
+    const auto p = perception->stats();
+    figures.push_back(
+        {"perception", p.clouds, perception->queue_depth(),
+         drops(r.colour, r.depth) + p.skipped + p.unpaired + p.bad_frames + p.without_pose,
+         perception->latency().percentiles()});
+  }
+  return figures;
 }
 
 int run(const semap::onboard::OnboardConfig& config) {
@@ -105,11 +122,15 @@ int run(const semap::onboard::OnboardConfig& config) {
   auto log = common::logger("onboard");
   SpscRing<common::ImuSample> imu_ring(config.imu.ring, OverflowPolicy::kDropOldest);
   SpscRing<common::GnssFix> gnss_ring(config.gnss.ring, OverflowPolicy::kDropOldest);
-  SpscRing<mapping::LabeledDepthImage> image_ring(config.camera.ring, OverflowPolicy::kDropOldest);
-  SpscRing<common::LabeledCloud> cloud_ring(config.camera.ring, OverflowPolicy::kDropOldest);
+  SpscRing<common::ImageFrame> colour_ring(config.camera.ring, OverflowPolicy::kDropOldest);
+  SpscRing<common::ImageFrame> depth_ring(config.depth.ring, OverflowPolicy::kDropOldest);
+  SpscRing<common::LabeledCloud> cloud_ring(config.depth.ring, OverflowPolicy::kDropOldest);
+  onboard::SharedPoseHistory poses(config.estimator.history);
 
   std::unique_ptr<onboard::SimRig> rig;
-  if (config.rig.simulated) rig = std::make_unique<onboard::SimRig>(config, imu_ring, image_ring);
+  if (config.rig.simulated) {
+    rig = std::make_unique<onboard::SimRig>(config, imu_ring, colour_ring, depth_ring);
+  }
 
   std::unique_ptr<drivers::GnssDriver> gnss_driver;
   auto gnss_config = config.gnss.driver;
@@ -122,11 +143,31 @@ int run(const semap::onboard::OnboardConfig& config) {
     imu_driver = std::make_unique<drivers::CanImuDriver>(config.imu.driver, imu_ring);
   }
 
+  // On hardware the camera is optional (an empty camera.device): without it the robot still
+  // estimates and publishes its pose, and its map stays empty.
+  const bool camera = rig || !config.camera.driver.device.empty();
+  std::unique_ptr<drivers::CameraDriver> camera_driver;
+  std::unique_ptr<drivers::CameraDriver> depth_driver;
+  if (camera && !rig) {
+    camera_driver = std::make_unique<drivers::CameraDriver>(config.camera.driver, colour_ring);
+    if (config.depth.source == onboard::DepthSource::kAligned) {
+      depth_driver = std::make_unique<drivers::CameraDriver>(config.depth.driver, depth_ring);
+    }
+  }
+  std::unique_ptr<onboard::PerceptionStage> perception_stage;
+  if (camera) {
+    perception_stage = std::make_unique<onboard::PerceptionStage>(
+        config.camera, config.depth,
+        onboard::make_segmenter(config.segmenter, config.map.num_classes), colour_ring,
+        config.depth.source == onboard::DepthSource::kAligned ? &depth_ring : nullptr, poses,
+        cloud_ring);
+  }
+
   std::unique_ptr<onboard::DdsOutputs> dds;
   if (config.dds.enabled) dds = std::make_unique<onboard::DdsOutputs>(config);
 
   onboard::EstimationStage estimation_stage(
-      config, imu_ring, gnss_ring, image_ring, cloud_ring,
+      config, imu_ring, gnss_ring, poses,
       dds ? onboard::EstimationStage::PoseSink(
                 [&](const onboard::PoseOutput& p) { dds->publish_pose(p); })
           : nullptr);
@@ -140,7 +181,10 @@ int run(const semap::onboard::OnboardConfig& config) {
 
   if (gnss_driver) gnss_driver->start();
   if (imu_driver) imu_driver->start();
+  if (camera_driver) camera_driver->start();
+  if (depth_driver) depth_driver->start();
   estimation_stage.start();
+  if (perception_stage) perception_stage->start();
   mapping_stage.start();
   if (rig) rig->start();
   log->info("running{}", rig ? " on the simulated rig (GNSS via " + rig->gnss_device() + ")" : "");
@@ -148,7 +192,7 @@ int run(const semap::onboard::OnboardConfig& config) {
   LiveAccuracy accuracy;
   const auto started = common::Stamp::now();
   auto next_report = started + 5.0;
-  const Rings rings{imu_ring, gnss_ring, image_ring, cloud_ring};
+  const Rings rings{imu_ring, gnss_ring, colour_ring, depth_ring, cloud_ring};
   onboard::HealthMonitor health;
   auto next_health = started;
   while (!g_stop.load()) {
@@ -162,15 +206,23 @@ int run(const semap::onboard::OnboardConfig& config) {
       if (gnss_driver)
         driver_counters.push_back(onboard::driver_health("gnss", gnss_driver->stats()));
       if (imu_driver) driver_counters.push_back(onboard::driver_health("imu", imu_driver->stats()));
+      if (camera_driver) {
+        driver_counters.push_back(onboard::driver_health("camera", camera_driver->stats()));
+      }
+      if (depth_driver) {
+        driver_counters.push_back(onboard::driver_health("depth", depth_driver->stats()));
+      }
       dds->publish_health(health.report(
-          now, stage_figures(rings, estimation_stage, mapping_stage, *dds), driver_counters));
+          now, stage_figures(rings, estimation_stage, perception_stage.get(), mapping_stage, *dds),
+          driver_counters));
     }
     if (now >= next_report) {
       next_report = now + 5.0;
       const auto map = mapping_stage.stats();
-      log->info("t={:.0f}s imu={} gnss={} init={} images={} scans={} blocks={} odom_out={}",
+      const auto frames = perception_stage ? perception_stage->stats().clouds : 0;
+      log->info("t={:.0f}s imu={} gnss={} init={} frames={} scans={} blocks={} odom_out={}",
                 common::seconds_between(now, started), est.imu_samples, est.gnss_fixes,
-                est.initialised, est.images_posed, map.scans, map.map.blocks,
+                est.initialised, frames, map.scans, map.map.blocks,
                 dds ? dds->odometry_written() : 0);
     }
     if (rig && rig->finished()) {
@@ -186,7 +238,10 @@ int run(const semap::onboard::OnboardConfig& config) {
   if (rig) rig->stop();
   if (imu_driver) imu_driver->stop();
   if (gnss_driver) gnss_driver->stop();
+  if (camera_driver) camera_driver->stop();
+  if (depth_driver) depth_driver->stop();
   estimation_stage.stop();
+  if (perception_stage) perception_stage->stop();
   mapping_stage.stop();
 
   const auto est = estimation_stage.stats();
@@ -216,8 +271,26 @@ int run(const semap::onboard::OnboardConfig& config) {
     std::printf("pose vs truth    : position RMSE %.3f m, max %.3f m over %zu checks\n",
                 accuracy.rmse(), accuracy.max(), accuracy.count());
   }
-  std::printf("perception       : %lu images posed, %lu without a pose\n", est.images_posed,
-              est.images_without_pose);
+  if (camera_driver) {
+    const auto c = camera_driver->stats();
+    std::printf("camera driver    : %lu frames, %lu bad, %lu reconnects\n", c.frames,
+                c.checksum_failures, c.reconnects);
+  }
+  if (perception_stage) {
+    const auto p = perception_stage->stats();
+    const auto lat = perception_stage->latency().percentiles();
+    std::printf(
+        "perception       : %lu frames, %lu clouds mapped (%lu points), %lu passed over, "
+        "%lu unpaired, %lu bad, %lu without a pose; segment mean %.1f ms max %.1f ms; "
+        "latency p50 %.1f ms p99 %.1f ms\n",
+        p.frames, p.clouds, p.points, p.skipped, p.unpaired, p.bad_frames, p.without_pose,
+        p.clouds ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
+        1e3 * p.segment_seconds_max, static_cast<double>(lat.p50_ms),
+        static_cast<double>(lat.p99_ms));
+    std::printf(
+        "pixels dropped   : %lu no depth, %lu out of range, %lu no label, %lu low confidence\n",
+        p.dropped.no_depth, p.dropped.out_of_range, p.dropped.no_label, p.dropped.low_confidence);
+  }
   std::printf(
       "mapping          : %lu scans, %lu points, insert mean %.1f ms max %.1f ms, "
       "%zu blocks, %zu observed cells, %.1f bytes/cell\n",
@@ -233,11 +306,19 @@ int run(const semap::onboard::OnboardConfig& config) {
         dds->odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
         dds->health_written());
   }
-  std::printf("ring drops       : imu %lu, gnss %lu, images %lu, clouds %lu\n", drops(imu_ring),
-              drops(gnss_ring), drops(image_ring), drops(cloud_ring));
-  // Without a camera (hardware rig today) an empty map is expected; a filter that never
-  // initialised is a failure either way.
-  const bool mapped = !rig || map.scans > 0;
+  std::printf("ring drops       : imu %lu, gnss %lu, colour %lu, depth %lu, clouds %lu\n",
+              drops(imu_ring), drops(gnss_ring), drops(colour_ring), drops(depth_ring),
+              drops(cloud_ring));
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const double cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                       1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  std::printf("cpu              : %.2f cores over %.1f s\n",
+              cpu_s / common::seconds_between(common::Stamp::now(), started),
+              common::seconds_between(common::Stamp::now(), started));
+  // Without a camera an empty map is expected; a filter that never initialised is a failure
+  // either way.
+  const bool mapped = !camera || map.scans > 0;
   return est.initialised && mapped ? 0 : 1;
 }
 

@@ -3,6 +3,7 @@
 #include <numbers>
 
 #include "semap/common/config.hpp"
+#include "semap/drivers/driver_config.hpp"
 
 namespace semap::onboard {
 
@@ -61,19 +62,98 @@ void read_gnss(const ConfigSection& s, GnssSourceConfig& gnss) {
   s.finish();
 }
 
+std::size_t ring_size(const ConfigSection& s, std::size_t fallback) {
+  const auto n =
+      static_cast<std::size_t>(s.get_in_range("ring", static_cast<double>(fallback), 2, 65536));
+  if ((n & (n - 1)) != 0) {
+    throw common::ConfigError(s.file() + ": key '" + s.path() + ".ring': " + std::to_string(n) +
+                              " is not a power of two");
+  }
+  return n;
+}
+
 void read_camera(const ConfigSection& s, CameraConfig& cam) {
-  const int width = static_cast<int>(s.get_in_range("width", 96, 8, 4096));
-  const int height = static_cast<int>(s.get_in_range("height", 64, 8, 4096));
-  const double fov = s.get_in_range("fov_deg", 90.0, 10.0, 170.0);
-  cam.intrinsics = mapping::PinholeIntrinsics::from_fov(
-      width, height, static_cast<float>(fov * std::numbers::pi / 180.0));
-  cam.rate_hz = s.get_in_range("rate_hz", cam.rate_hz, 0.1, 60.0);
-  cam.max_range = static_cast<float>(s.get_in_range("max_range", cam.max_range, 1.0, 200.0));
-  cam.stride = static_cast<int>(s.get_in_range("stride", cam.stride, 1, 64));
+  cam.driver = drivers::camera_config(s);
+  const int width = static_cast<int>(cam.driver.width);
+  const int height = static_cast<int>(cam.driver.height);
+  if (s.has("fx")) {
+    cam.intrinsics.width = width;
+    cam.intrinsics.height = height;
+    cam.intrinsics.fx = static_cast<float>(s.get_in_range("fx", 0, 1, 1e5));
+    cam.intrinsics.fy = static_cast<float>(s.get_in_range("fy", 0, 1, 1e5));
+    cam.intrinsics.cx = static_cast<float>(s.get_in_range("cx", 0, 0, width));
+    cam.intrinsics.cy = static_cast<float>(s.get_in_range("cy", 0, 0, height));
+  } else {
+    const double fov = s.get_in_range("fov_deg", 90.0, 10.0, 170.0);
+    cam.intrinsics = perception::PinholeIntrinsics::from_fov(
+        width, height, static_cast<float>(fov * std::numbers::pi / 180.0));
+  }
   cam.mount_xyz = vector3(s, "mount_xyz", cam.mount_xyz);
-  cam.mount_pitch_deg =
-      static_cast<float>(s.get_in_range("mount_pitch_deg", cam.mount_pitch_deg, -90, 90));
-  cam.ring = static_cast<std::size_t>(s.get_in_range("ring", 8, 2, 1024));
+  cam.mount_rpy_deg = vector3(s, "mount_rpy_deg", cam.mount_rpy_deg);
+  cam.ring = ring_size(s, cam.ring);
+  s.finish();
+}
+
+void read_depth(const ConfigSection& s, const CameraConfig& camera, DepthConfig& depth) {
+  depth.source = s.get_choice("source", "aligned", {"aligned", "stereo"}) == "stereo"
+                     ? DepthSource::kStereo
+                     : DepthSource::kAligned;
+  if (depth.source == DepthSource::kAligned) {
+    depth.driver = drivers::camera_config(s);
+    if (!s.has("format")) depth.driver.format = common::PixelFormat::kZ16;
+    if (depth.driver.format != common::PixelFormat::kZ16) {
+      throw common::ConfigError(s.file() + ": key '" + s.path() +
+                                ".format': an aligned depth device delivers Z16");
+    }
+    // Aligned means pixel for pixel: the size and rate are the colour camera's unless set.
+    if (!s.has("width")) depth.driver.width = camera.driver.width;
+    if (!s.has("height")) depth.driver.height = camera.driver.height;
+    if (!s.has("fps")) depth.driver.fps = camera.driver.fps;
+    if (depth.driver.width != camera.driver.width || depth.driver.height != camera.driver.height) {
+      throw common::ConfigError(
+          s.file() + ": key '" + s.path() + ".width/height': aligned depth of " +
+          std::to_string(depth.driver.width) + "x" + std::to_string(depth.driver.height) +
+          " does not match the camera's " + std::to_string(camera.driver.width) + "x" +
+          std::to_string(camera.driver.height));
+    }
+    depth.depth_scale =
+        static_cast<float>(s.get_in_range("depth_scale", depth.depth_scale, 1e-6, 1.0));
+    depth.sync_tolerance_s =
+        s.get_in_range("sync_tolerance_ms", 1e3 * depth.sync_tolerance_s, 0.0, 1000.0) / 1e3;
+  } else {
+    depth.stereo_calibration = std::filesystem::absolute(s.get<std::string>("calibration"));
+    depth.stereo.num_disparities =
+        static_cast<int>(s.get_in_range("num_disparities", depth.stereo.num_disparities, 16, 512));
+    if (depth.stereo.num_disparities % 16 != 0) {
+      throw common::ConfigError(s.file() + ": key '" + s.path() +
+                                ".num_disparities': must be a multiple of 16");
+    }
+    depth.stereo.block_size =
+        static_cast<int>(s.get_in_range("block_size", depth.stereo.block_size, 1, 31));
+    if (depth.stereo.block_size % 2 == 0) {
+      throw common::ConfigError(s.file() + ": key '" + s.path() + ".block_size': must be odd");
+    }
+  }
+  auto& p = depth.points;
+  p.stride = static_cast<int>(s.get_in_range("stride", p.stride, 1, 64));
+  p.max_range = static_cast<float>(s.get_in_range("max_range", p.max_range, 0.1, 200.0));
+  p.min_confidence =
+      static_cast<float>(s.get_in_range("min_confidence", p.min_confidence, 0.0, 1.0));
+  p.soft_labels = s.get<bool>("soft_labels", p.soft_labels);
+  depth.ring = ring_size(s, depth.ring);
+  s.finish();
+}
+
+void read_segmenter(const ConfigSection& s, SegmenterConfig& seg) {
+  seg.kind = s.get_choice("kind", "palette", {"onnx", "palette"}) == "onnx"
+                 ? SegmenterConfig::Kind::kOnnx
+                 : SegmenterConfig::Kind::kPalette;
+  if (seg.kind == SegmenterConfig::Kind::kOnnx) {
+    seg.model_card = std::filesystem::absolute(s.get<std::string>("model_card"));
+  } else {
+    if (s.has("palette")) seg.palette = std::filesystem::absolute(s.get<std::string>("palette"));
+    seg.confidence = static_cast<float>(s.get_in_range("confidence", seg.confidence, 0.01, 1.0));
+  }
   s.finish();
 }
 
@@ -93,16 +173,6 @@ void read_dds(const ConfigSection& s, DdsConfig& dds) {
 
 }  // namespace
 
-Eigen::Isometry3f CameraConfig::body_from_optical() const {
-  Eigen::Isometry3f t = Eigen::Isometry3f::Identity();
-  // A positive rotation about the FLU y axis tips the optical axis down.
-  const float pitch = mount_pitch_deg * std::numbers::pi_v<float> / 180.0f;
-  t.linear() = Eigen::AngleAxisf(pitch, Eigen::Vector3f::UnitY()).toRotationMatrix() *
-               mapping::optical_to_flu();
-  t.translation() = mount_xyz;
-  return t;
-}
-
 OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   const auto root = ConfigSection::load_file(path);
   OnboardConfig c;
@@ -111,6 +181,8 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   read_imu(root.section_or_empty("imu"), c.imu);
   read_gnss(root.section_or_empty("gnss"), c.gnss);
   read_camera(root.section_or_empty("camera"), c.camera);
+  read_depth(root.section_or_empty("depth"), c.camera, c.depth);
+  read_segmenter(root.section_or_empty("segmenter"), c.segmenter);
   c.estimator = estimation::load_estimator_config(root.section_or_empty("estimator"));
   const auto map = root.section_or_empty("map");
   c.map = mapping::map_params_from_config(map, c.map);
@@ -121,6 +193,10 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);
   root.finish();
+  if (c.rig.simulated && c.depth.source != DepthSource::kAligned) {
+    throw common::ConfigError(path.string() +
+                              ": key 'depth.source': the simulated rig renders aligned depth only");
+  }
   c.map.validate();
   return c;
 }

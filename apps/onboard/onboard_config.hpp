@@ -6,12 +6,12 @@
 #include <optional>
 #include <string>
 
+#include "perception_config.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/drivers/gnss_driver.hpp"
 #include "semap/estimation/estimator_config.hpp"
 #include "semap/estimation/simulator.hpp"
 #include "semap/firmware_bridge/emulator.hpp"
-#include "semap/mapping/depth_projection.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/semantic_layers.hpp"
 
@@ -43,19 +43,6 @@ struct GnssSourceConfig {
   std::size_t ring = 256;
 };
 
-struct CameraConfig {
-  mapping::PinholeIntrinsics intrinsics;
-  double rate_hz = 5.0;
-  float max_range = 20.0f;
-  int stride = 1;                               // back-project every stride-th pixel
-  Eigen::Vector3f mount_xyz{0.3f, 0.0f, 1.5f};  // camera centre in the body frame
-  float mount_pitch_deg = 15.0f;                // downward tilt
-  std::size_t ring = 8;
-
-  // The camera's optical frame in the body frame (shared by the rig and perception).
-  Eigen::Isometry3f body_from_optical() const;
-};
-
 struct DdsConfig {
   bool enabled = true;
   // Cyclone XML (relative to the working directory, like the other semap apps); exported as
@@ -74,6 +61,8 @@ struct OnboardConfig {
   ImuSourceConfig imu;
   GnssSourceConfig gnss;
   CameraConfig camera;
+  DepthConfig depth;
+  SegmenterConfig segmenter;
   estimation::EstimatorConfig estimator;
   mapping::MapParams map;
   std::string map_save_path;       // .smap written at exit when set

@@ -7,7 +7,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -34,6 +36,21 @@ std::vector<Eigen::Vector3d> path_of(const estimation::SimulationData& data) {
   return path;
 }
 
+// The colours the rig's camera paints each scene class with: the Cityscapes palette's road,
+// building and pole, and sky where nothing was hit, so the palette segmenter reads them back.
+struct SceneColour {
+  std::array<std::uint8_t, 3> bgr;
+};
+const SceneColour& scene_colour(std::uint16_t label) {
+  static const std::array<SceneColour, 4> colours = {{
+      {{180, 130, 70}},   // sky (no return)
+      {{128, 64, 128}},   // ground: road
+      {{70, 70, 70}},     // building
+      {{153, 153, 153}},  // pole
+  }};
+  return colours[std::min<std::size_t>(label, colours.size() - 1)];
+}
+
 void sleep_until(common::Stamp when, std::stop_token stop) {
   while (!stop.stop_requested()) {
     const common::Stamp now = common::Stamp::now();
@@ -47,14 +64,16 @@ void sleep_until(common::Stamp when, std::stop_token stop) {
 }  // namespace
 
 SimRig::SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu_ring,
-               common::SpscRing<mapping::LabeledDepthImage>& depth_ring)
+               common::SpscRing<common::ImageFrame>& colour_ring,
+               common::SpscRing<common::ImageFrame>& depth_ring)
     : config_(config),
       imu_ring_(imu_ring),
+      colour_ring_(colour_ring),
       depth_ring_(depth_ring),
       data_(simulate_drive(config)),
-      scene_(mapping::SyntheticScene::around_path(path_of(data_), 4.0f, config.rig.obstacles,
-                                                  config.rig.scene_seed)),
-      camera_(config.camera.intrinsics, config.camera.max_range),
+      scene_(perception::SyntheticScene::around_path(path_of(data_), 4.0f, config.rig.obstacles,
+                                                     config.rig.scene_seed)),
+      camera_(config.camera.intrinsics, config.depth.points.max_range),
       body_from_optical_(config.camera.body_from_optical()) {
   firmware_bridge::EmulatorConfig emu;
   emu.gnss_protocol = config.gnss.protocol;
@@ -112,14 +131,42 @@ void SimRig::render_image(const estimation::TruthSample& truth, common::Stamp st
   Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
   world_from_body.linear() = truth.state.rotation.cast<float>();
   world_from_body.translation() = truth.state.position.cast<float>();
-  depth_ring_.try_push(camera_.render(scene_, world_from_body * body_from_optical_, stamp));
+  const auto image = camera_.render(scene_, world_from_body * body_from_optical_, stamp);
+  const auto& k = config_.camera.intrinsics;
+  const auto pixels = static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height);
+
+  common::ImageFrame colour;
+  colour.stamp = stamp;
+  colour.sequence = sequence_;
+  colour.format = common::PixelFormat::kBgr24;
+  colour.width = static_cast<std::uint32_t>(k.width);
+  colour.height = static_cast<std::uint32_t>(k.height);
+  colour.stride = 3 * colour.width;
+  colour.data.resize(3 * pixels);
+  common::ImageFrame depth = colour;
+  depth.format = common::PixelFormat::kZ16;
+  depth.stride = 2 * depth.width;
+  depth.data.assign(2 * pixels, 0);
+  const float units_per_metre = 1.0f / config_.depth.depth_scale;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const float z = image.depth[i];
+    const bool hit = z > 0.0f;
+    const SceneColour& c = scene_colour(hit ? image.labels[i] : 0);
+    std::copy(c.bgr.begin(), c.bgr.end(), colour.data.begin() + static_cast<std::ptrdiff_t>(3 * i));
+    const auto units =
+        hit ? static_cast<std::uint16_t>(std::min(65535.0f, std::round(z * units_per_metre))) : 0;
+    std::memcpy(depth.data.data() + 2 * i, &units, sizeof units);
+  }
+  ++sequence_;
+  colour_ring_.try_push(std::move(colour));
+  depth_ring_.try_push(std::move(depth));
   images_.fetch_add(1, std::memory_order_acq_rel);
 }
 
 void SimRig::run(std::stop_token stop) {
   auto log = common::logger("sim_rig");
   const double duration = config_.rig.duration_s > 0 ? config_.rig.duration_s : 1e12;
-  const double camera_period = 1.0 / config_.camera.rate_hz;
+  const double camera_period = 1.0 / config_.camera.driver.fps;
   double next_camera = data_.truth.empty() ? 0.0 : data_.truth.front().stamp.seconds();
   firmware_bridge::VectorSource source(data_.imu, data_.gnss);
   std::size_t imu_index = 0;

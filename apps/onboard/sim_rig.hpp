@@ -10,20 +10,24 @@
 #include "semap/estimation/simulator.hpp"
 #include "semap/firmware_bridge/emulator.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
-#include "semap/mapping/synthetic_depth_camera.hpp"
-#include "semap/mapping/synthetic_scene.hpp"
+#include "semap/perception/synthetic_depth_camera.hpp"
+#include "semap/perception/synthetic_scene.hpp"
 
 namespace semap::onboard {
 
 // The built-in simulated sensor rig. It plays a simulated drive in real time: GNSS as NMEA/UBX
 // bytes into a pseudo-terminal (read by the real GnssDriver through termios), IMU as CAN
 // frames on a SocketCAN interface when one is configured (read by the real CanImuDriver) or
-// straight into the IMU ring otherwise, and depth + class images of a synthetic world seen
-// from the true pose. Sensor stamps are CLOCK_MONOTONIC, as real drivers would give them.
+// straight into the IMU ring otherwise, and camera frames of a synthetic world seen from the
+// true pose: a colour frame whose colours encode the classes (Cityscapes palette, for the
+// palette segmenter) and an aligned Z16 depth frame, into the rings a colour camera driver
+// and a depth camera driver would fill. Sensor stamps are CLOCK_MONOTONIC, as real drivers
+// would give them.
 class SimRig {
  public:
   SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu_ring,
-         common::SpscRing<mapping::LabeledDepthImage>& depth_ring);
+         common::SpscRing<common::ImageFrame>& colour_ring,
+         common::SpscRing<common::ImageFrame>& depth_ring);
   ~SimRig();
   SimRig(const SimRig&) = delete;
   SimRig& operator=(const SimRig&) = delete;
@@ -38,7 +42,7 @@ class SimRig {
   // Truth at a monotonic stamp (nearest simulated sample), in the simulator's ENU frame.
   std::optional<estimation::TruthSample> truth_at(common::Stamp stamp) const;
   const estimation::SimulationData& data() const { return data_; }
-  const mapping::SyntheticScene& scene() const { return scene_; }
+  const perception::SyntheticScene& scene() const { return scene_; }
   const firmware_bridge::EmulatorStats& emulator_stats() const { return emulator_->stats(); }
   std::uint64_t images_rendered() const { return images_.load(std::memory_order_acquire); }
 
@@ -48,10 +52,11 @@ class SimRig {
 
   const OnboardConfig& config_;
   common::SpscRing<common::ImuSample>& imu_ring_;
-  common::SpscRing<mapping::LabeledDepthImage>& depth_ring_;
+  common::SpscRing<common::ImageFrame>& colour_ring_;
+  common::SpscRing<common::ImageFrame>& depth_ring_;
   estimation::SimulationData data_;
-  mapping::SyntheticScene scene_;
-  mapping::SyntheticDepthCamera camera_;
+  perception::SyntheticScene scene_;
+  perception::SyntheticDepthCamera camera_;
   Eigen::Isometry3f body_from_optical_;
   int pty_master_ = -1;
   int pty_slave_fd_ = -1;
@@ -60,6 +65,7 @@ class SimRig {
   std::unique_ptr<firmware_bridge::Emulator> emulator_;
   common::Stamp start_;
   std::atomic<bool> finished_{false};
+  std::uint32_t sequence_ = 0;
   std::atomic<std::uint64_t> images_{0};
   std::jthread thread_;
 };

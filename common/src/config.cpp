@@ -184,6 +184,17 @@ ConfigSection ConfigSection::section_or_empty(const std::string& key) const {
   return section(key);
 }
 
+void ConfigSection::reject(const std::string& key, const std::string& what) const {
+  fail(node_.IsMap() ? node_[key] : YAML::Node(), key, what);
+}
+
+void ConfigSection::reject(const std::string& key, std::size_t index,
+                           const std::string& what) const {
+  const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node();
+  const bool in_list = n.IsSequence() && index < n.size();
+  fail(in_list ? n[index] : n, key, "element " + std::to_string(index) + ": " + what);
+}
+
 void ConfigSection::finish() const {
   if (!node_.IsMap()) return;
   for (const auto& kv : node_) {

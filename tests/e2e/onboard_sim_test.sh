@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # semap-onboard on the simulated rig for 20 s while semap-map-listener follows the map over
 # DDS on loopback. Passes when the robot initialised, its pose stayed within 1 m of the
-# simulated truth, it mapped (nearly) every posed image, and the listener received blocks with no
+# simulated truth, its perception stage turned the rig's camera frames into posed clouds and
+# the map took (nearly) every one of them, and the listener received blocks with no
 # rejections, and the map it saved at exit exports to a top-down PNG. The listener also prints
 # the robot's rt/semap/health reports, which must carry plausible figures.
 set -euo pipefail
@@ -27,7 +28,11 @@ rmse=$(sed -n 's/.*position RMSE \([0-9.]*\) m.*/\1/p' "$work/onboard.log")
 awk -v r="$rmse" 'BEGIN { exit !(r < 1.0) }' || { echo "pose RMSE $rmse m >= 1 m"; exit 1; }
 grep -q "gated out), initialised=yes" "$work/onboard.log" || { echo "not initialised"; exit 1; }
 scans=$(sed -n 's/^mapping *: \([0-9]*\) scans.*/\1/p' "$work/onboard.log")
-posed=$(sed -n 's/^perception *: \([0-9]*\) images posed.*/\1/p' "$work/onboard.log")
+posed=$(sed -n 's/^perception *: [0-9]* frames, \([0-9]*\) clouds mapped.*/\1/p' "$work/onboard.log")
+frames=$(sed -n 's/^perception *: \([0-9]*\) frames.*/\1/p' "$work/onboard.log")
+# The rig renders at 5 Hz for 20 s; the first frames come before the filter initialises.
+[[ -n "$posed" && -n "$frames" && "$frames" -ge 90 && $(( posed * 10 )) -ge $(( frames * 7 )) ]] || {
+  echo "perception: $frames frames, $posed clouds"; exit 1; }
 # The cloud ring drops the oldest scan rather than stall perception; allow a few drops.
 [[ "$scans" -gt 50 && $(( scans * 10 )) -ge $(( posed * 9 )) ]] || {
   echo "scans $scans, posed $posed"; exit 1; }
@@ -53,6 +58,8 @@ est_rate=$(field "$health" stage estimation rate)
 est_p50=$(field "$health" stage estimation p50)
 est_p99=$(field "$health" stage estimation p99)
 map_drops=$(field "$health" stage mapping drops)
+perc_rate=$(field "$health" stage perception rate)
+perc_p99=$(field "$health" stage perception p99)
 gnss_frames=$(field "$health" driver gnss frames)
 gnss_bad=$(field "$health" driver gnss bad)
 awk -v r="$est_rate" -v a="$est_p50" -v b="$est_p99" 'BEGIN { exit !(r > 50 && b >= a && b < 1000) }' || {
@@ -60,6 +67,8 @@ awk -v r="$est_rate" -v a="$est_p50" -v b="$est_p99" 'BEGIN { exit !(r > 50 && b
 grep '^health: ' "$work/listener.log" | awk '{ for (i = 1; i < NF; i++) if ($i == "mapping" && $(i + 2) > 0) ok = 1 }
   END { exit !ok }' || { echo "mapping rate never > 0 in health"; grep '^health: ' "$work/listener.log"; exit 1; }
 [[ "$gnss_frames" -gt 0 && "$gnss_bad" -eq 0 ]] || { echo "gnss driver health: $health"; exit 1; }
+awk -v r="$perc_rate" -v b="$perc_p99" 'BEGIN { exit !(r > 2 && b > 0 && b < 1000) }' || {
+  echo "perception health implausible: $health"; exit 1; }
 # Ring drops in the health report are the rings' own counters: never more than at exit.
 cloud_drops=$(sed -n 's/^ring drops .* clouds \([0-9]*\)$/\1/p' "$work/onboard.log")
 [[ -n "$map_drops" && -n "$cloud_drops" && "$map_drops" -le "$cloud_drops" ]] || {

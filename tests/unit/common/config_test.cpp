@@ -78,6 +78,19 @@ TEST(Config, MissingRequiredKeyAndFile) {
   EXPECT_NE(msg.find("/nonexistent/semap.yaml"), std::string::npos) << msg;
 }
 
+TEST(Config, RejectNamesFileLineAndKey) {
+  const auto root = ConfigSection::load_string(
+      "map:\n  num_classes: 4\n  classes:\n    - 1\n    - 9\n", "robot.yaml");
+  const auto map = root.section("map");
+  std::string msg = error_of([&] { map.reject("num_classes", "must agree with classes"); });
+  EXPECT_NE(msg.find("robot.yaml:2: key 'map.num_classes': must agree"), std::string::npos) << msg;
+  msg = error_of([&] { map.reject("classes", 1, "out of range"); });
+  EXPECT_NE(msg.find("robot.yaml:5: key 'map.classes': element 1: out of range"), std::string::npos)
+      << msg;
+  msg = error_of([&] { map.reject("ell", "required with method bki"); });
+  EXPECT_NE(msg.find("robot.yaml:2: key 'map.ell'"), std::string::npos) << msg;
+}
+
 TEST(Config, SyntaxErrorNamesLine) {
   const auto path = std::filesystem::temp_directory_path() / "semap_config_test.yaml";
   std::ofstream(path) << "map:\n  resolution: [0.1\n";

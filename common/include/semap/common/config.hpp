@@ -49,6 +49,13 @@ class ConfigSection {
   // Throws if the mapping holds keys that were never read. Call after reading a section.
   void finish() const;
 
+  // For rules only the caller can check (counts that must agree, a value that depends on
+  // another): throws ConfigError naming `file:line: key` like the built-in checks. The second
+  // form points at element `index` of a list value, so the line is that element's.
+  [[noreturn]] void reject(const std::string& key, const std::string& what) const;
+  [[noreturn]] void reject(const std::string& key, std::size_t index,
+                           const std::string& what) const;
+
   const std::string& path() const { return path_; }
   const std::string& file() const { return state_->file; }
 

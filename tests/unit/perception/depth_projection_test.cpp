@@ -1,12 +1,15 @@
-#include "semap/mapping/depth_projection.hpp"
+#include "semap/perception/depth_projection.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <numbers>
+#include <opencv2/core.hpp>
 
-#include "semap/mapping/synthetic_depth_camera.hpp"
+#include "semap/perception/depth_cloud.hpp"
+#include "semap/perception/synthetic_depth_camera.hpp"
 
-namespace semap::mapping {
+namespace semap::perception {
 namespace {
 
 TEST(PinholeIntrinsics, FromFov) {
@@ -24,8 +27,19 @@ TEST(OpticalToFlu, MapsAxes) {
   EXPECT_NEAR(r.determinant(), 1.0f, 1e-6f);
 }
 
+// The rendered class image as a segmenter's hard labels (what a perfect segmenter gives).
+Segmentation perfect_segmentation(const LabeledDepthImage& image, const PinholeIntrinsics& k) {
+  Segmentation seg;
+  seg.num_classes = 4;
+  seg.labels = cv::Mat(k.height, k.width, CV_16UC1);
+  std::copy(image.labels.begin(), image.labels.end(), seg.labels.begin<std::uint16_t>());
+  seg.labels.setTo(kNoLabel, seg.labels == 0);  // no hit: sky
+  seg.confidence = cv::Mat(k.height, k.width, CV_32FC1, cv::Scalar(1.0f));
+  return seg;
+}
+
 // Rendering a known world and back-projecting must land every point on the surface it hit.
-TEST(BackProject, RecoversRenderedSurfaces) {
+TEST(SyntheticDepthCamera, BackProjectsOntoTheRenderedSurfaces) {
   SyntheticScene scene;
   scene.add_box(Eigen::Vector3f(6, -20, 0), Eigen::Vector3f(7, 20, 5));  // a wall at x = 6
   const auto k = PinholeIntrinsics::from_fov(64, 48, std::numbers::pi_v<float> / 2);
@@ -34,9 +48,15 @@ TEST(BackProject, RecoversRenderedSurfaces) {
   world_from_optical.linear() = optical_to_flu();
   world_from_optical.translation() = Eigen::Vector3f(0, 0, 1.5f);
   const auto image = camera.render(scene, world_from_optical, common::Stamp(42));
-  const auto cloud = back_project(image, k, world_from_optical, 1, 30.0f);
+  EXPECT_EQ(image.stamp, common::Stamp(42));
+  const cv::Mat depth(k.height, k.width, CV_32FC1, const_cast<float*>(image.depth.data()));
+  PointOptions options;
+  options.max_range = 30.0f;
+  DropCounts drops;
+  const auto cloud = cloud_from_depth(depth, perfect_segmentation(image, k), k, world_from_optical,
+                                      options, drops);
   ASSERT_GT(cloud.size(), 1000u);
-  EXPECT_EQ(cloud.stamp, common::Stamp(42));
+  EXPECT_EQ(cloud.size() + drops.total(), static_cast<std::size_t>(k.width * k.height));
   EXPECT_TRUE(cloud.origin.isApprox(Eigen::Vector3f(0, 0, 1.5f)));
   int wall = 0;
   int ground = 0;
@@ -53,24 +73,7 @@ TEST(BackProject, RecoversRenderedSurfaces) {
   }
   EXPECT_GT(wall, 0);
   EXPECT_GT(ground, 0);
-  // A stride of 2 keeps a quarter of the pixels.
-  const auto sparse = back_project(image, k, world_from_optical, 2, 30.0f);
-  EXPECT_NEAR(static_cast<double>(sparse.size()), cloud.size() / 4.0, cloud.size() * 0.05);
-}
-
-TEST(BackProject, SkipsInvalidDepthAndMismatchedImages) {
-  const auto k = PinholeIntrinsics::from_fov(4, 4, 1.0f);
-  LabeledDepthImage image;
-  image.depth.assign(16, 2.0f);
-  image.labels.assign(16, 1);
-  image.depth[0] = std::numeric_limits<float>::quiet_NaN();
-  image.depth[1] = -1.0f;
-  image.depth[2] = 0.0f;
-  image.depth[3] = 100.0f;
-  EXPECT_EQ(back_project(image, k, Eigen::Isometry3f::Identity(), 1, 50.0f).size(), 12u);
-  image.labels.pop_back();
-  EXPECT_EQ(back_project(image, k, Eigen::Isometry3f::Identity(), 1, 50.0f).size(), 0u);
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::perception

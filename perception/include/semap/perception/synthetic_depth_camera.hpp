@@ -2,10 +2,10 @@
 
 #include <Eigen/Geometry>
 
-#include "semap/mapping/depth_projection.hpp"
-#include "semap/mapping/synthetic_scene.hpp"
+#include "semap/perception/depth_projection.hpp"
+#include "semap/perception/synthetic_scene.hpp"
 
-namespace semap::mapping {
+namespace semap::perception {
 
 // Renders what a depth camera with a perfect segmenter sees of a SyntheticScene: z-depth
 // and class per pixel, no return beyond max_range.
@@ -23,4 +23,4 @@ class SyntheticDepthCamera {
   float max_range_;
 };
 
-}  // namespace semap::mapping
+}  // namespace semap::perception

@@ -1,6 +1,6 @@
-#include "semap/mapping/synthetic_depth_camera.hpp"
+#include "semap/perception/synthetic_depth_camera.hpp"
 
-namespace semap::mapping {
+namespace semap::perception {
 
 SyntheticDepthCamera::SyntheticDepthCamera(const PinholeIntrinsics& intrinsics, float max_range)
     : intrinsics_(intrinsics), max_range_(max_range) {}
@@ -30,4 +30,4 @@ LabeledDepthImage SyntheticDepthCamera::render(const SyntheticScene& scene,
   return image;
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::perception

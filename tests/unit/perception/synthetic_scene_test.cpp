@@ -1,10 +1,10 @@
-#include "semap/mapping/synthetic_scene.hpp"
+#include "semap/perception/synthetic_scene.hpp"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-namespace semap::mapping {
+namespace semap::perception {
 namespace {
 
 TEST(SyntheticScene, GroundHitAtExpectedRange) {
@@ -57,4 +57,4 @@ TEST(SyntheticScene, AroundPathKeepsCorridorClear) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::perception

@@ -1,11 +1,11 @@
-#include "semap/mapping/synthetic_scene.hpp"
+#include "semap/perception/synthetic_scene.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 
-namespace semap::mapping {
+namespace semap::perception {
 
 namespace {
 
@@ -131,4 +131,4 @@ std::optional<RayHit> SyntheticScene::cast(const Eigen::Vector3f& origin,
   return hit;
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::perception

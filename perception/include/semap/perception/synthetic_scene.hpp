@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-namespace semap::mapping {
+namespace semap::perception {
 
 struct RayHit {
   float range = 0.0f;
@@ -63,4 +63,4 @@ class SyntheticScene {
   std::vector<Cylinder> cylinders_;
 };
 
-}  // namespace semap::mapping
+}  // namespace semap::perception

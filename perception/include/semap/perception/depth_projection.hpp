@@ -7,7 +7,7 @@
 
 #include "semap/common/messages.hpp"
 
-namespace semap::mapping {
+namespace semap::perception {
 
 // Pinhole model in the optical frame (x right, y down, z forward).
 struct PinholeIntrinsics {
@@ -36,12 +36,4 @@ struct LabeledDepthImage {
 // Rotation from the optical frame to a FLU body frame (optical z forward = body x).
 Eigen::Matrix3f optical_to_flu();
 
-// Back-projects every `stride`-th pixel with a return in (0, max_range] into the target frame
-// through `target_from_optical`; the cloud's origin is the camera centre in that frame.
-// Non-finite or out-of-range depths are skipped.
-common::LabeledCloud back_project(const LabeledDepthImage& image,
-                                  const PinholeIntrinsics& intrinsics,
-                                  const Eigen::Isometry3f& target_from_optical, int stride,
-                                  float max_range);
-
-}  // namespace semap::mapping
+}  // namespace semap::perception

@@ -1,0 +1,53 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <filesystem>
+
+#include "semap/drivers/camera_driver.hpp"
+#include "semap/perception/depth_projection.hpp"
+#include "semap/perception/labelled_points.hpp"
+#include "semap/perception/stereo_depth.hpp"
+
+namespace semap::onboard {
+
+// camera: the colour camera (a V4L2 device on hardware, rendered on the simulated rig).
+struct CameraConfig {
+  drivers::CameraConfig driver;  // device, format, width, height, fps, buffers
+  perception::PinholeIntrinsics intrinsics;
+  Eigen::Vector3f mount_xyz{0.3f, 0.0f, 1.5f};  // camera centre in the body frame, m
+  // Roll, pitch (positive tips the optical axis down), yaw of the camera in the body frame.
+  Eigen::Vector3f mount_rpy_deg{0.0f, 15.0f, 0.0f};
+  std::size_t ring = 4;
+
+  // The camera's optical frame in the body frame (shared by the rig and perception).
+  Eigen::Isometry3f body_from_optical() const;
+};
+
+enum class DepthSource {
+  kAligned,  // a Z16 depth image aligned with the colour image, from a second device
+  kStereo,   // the camera delivers a rectifiable stereo pair side by side in one frame
+};
+
+// depth: where the labelled pixels get their range.
+struct DepthConfig {
+  DepthSource source = DepthSource::kAligned;
+  // The depth device (aligned); on the simulated rig only the size and rate matter.
+  drivers::CameraConfig driver;
+  float depth_scale = 0.001f;                // metres per Z16 unit
+  double sync_tolerance_s = 0.02;            // colour and depth frames further apart do not pair
+  std::filesystem::path stereo_calibration;  // OpenCV YAML or KITTI calib_cam_to_cam.txt
+  perception::StereoOptions stereo;
+  perception::PointOptions points;  // stride, max_range, min_confidence, soft_labels
+  std::size_t ring = 4;
+};
+
+// segmenter: what labels the pixels.
+struct SegmenterConfig {
+  enum class Kind { kOnnx, kPalette } kind = Kind::kPalette;
+  std::filesystem::path model_card;  // onnx
+  std::filesystem::path palette;     // palette: YAML file; empty = built-in Cityscapes palette
+  float confidence = 0.9f;           // palette: probability given to the colour's class
+};
+
+}  // namespace semap::onboard

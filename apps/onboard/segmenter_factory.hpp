@@ -1,0 +1,16 @@
+#pragma once
+
+#include <memory>
+
+#include "perception_config.hpp"
+#include "semap/perception/segmentation.hpp"
+
+namespace semap::onboard {
+
+// The segmenter the `segmenter:` section asks for, labelling into the map's `map_classes`
+// classes. Throws (naming the file and key) when the model card or palette does not load or
+// its class count differs from the map's.
+std::unique_ptr<perception::Segmenter> make_segmenter(const SegmenterConfig& config,
+                                                      int map_classes);
+
+}  // namespace semap::onboard

@@ -1,0 +1,257 @@
+// The onboard perception stage on real rings, a real palette segmenter and a pose history:
+// frames in, posed labelled clouds out, every frame that cannot be used counted by reason.
+#include "perception_stage.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <numbers>
+#include <thread>
+
+#include "semap/perception/palette_segmenter.hpp"
+
+namespace semap::onboard {
+namespace {
+
+using common::ImageFrame;
+using common::LabeledCloud;
+using common::OverflowPolicy;
+using common::SpscRing;
+using common::Stamp;
+
+constexpr int kWidth = 32;
+constexpr int kHeight = 24;
+constexpr int kClasses = 4;
+constexpr float kDepth = 5.0f;  // metres, every pixel
+
+common::Stamp at(double seconds) { return Stamp::from_seconds(seconds); }
+
+// A colour frame painted with the Cityscapes road colour (map class 1 in the default mapping),
+// except its top row, which has an unknown colour.
+ImageFrame colour_frame(double t, std::uint32_t sequence) {
+  ImageFrame f;
+  f.stamp = at(t);
+  f.sequence = sequence;
+  f.format = common::PixelFormat::kBgr24;
+  f.width = kWidth;
+  f.height = kHeight;
+  f.stride = 3 * kWidth;
+  f.data.resize(static_cast<std::size_t>(f.stride) * kHeight);
+  for (int i = 0; i < kWidth * kHeight; ++i) {
+    const bool top = i < kWidth;
+    const std::uint8_t bgr[3] = {static_cast<std::uint8_t>(top ? 1 : 128),
+                                 static_cast<std::uint8_t>(top ? 2 : 64),
+                                 static_cast<std::uint8_t>(top ? 3 : 128)};
+    std::memcpy(f.data.data() + 3 * i, bgr, 3);
+  }
+  return f;
+}
+
+ImageFrame depth_frame(double t, std::uint32_t sequence, int width = kWidth) {
+  ImageFrame f;
+  f.stamp = at(t);
+  f.sequence = sequence;
+  f.format = common::PixelFormat::kZ16;
+  f.width = static_cast<std::uint32_t>(width);
+  f.height = kHeight;
+  f.stride = 2 * f.width;
+  const auto units = static_cast<std::uint16_t>(kDepth * 1000.0f);
+  f.data.resize(static_cast<std::size_t>(f.stride) * kHeight);
+  for (std::size_t i = 0; i < f.data.size() / 2; ++i) std::memcpy(&f.data[2 * i], &units, 2);
+  return f;
+}
+
+// Poses every 10 ms from t0 to t1: driving along x at 2 m/s, facing +x.
+std::vector<estimation::StampedPose> drive(double t0, double t1) {
+  std::vector<estimation::StampedPose> poses;
+  for (double t = t0; t <= t1 + 1e-9; t += 0.01) {
+    estimation::StampedPose p;
+    p.stamp = at(t);
+    p.position = Eigen::Vector3d(2.0 * t, 0.0, 0.0);
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+class PerceptionStageTest : public ::testing::Test {
+ protected:
+  PerceptionStageTest() {
+    camera_.driver.width = kWidth;
+    camera_.driver.height = kHeight;
+    camera_.intrinsics =
+        perception::PinholeIntrinsics::from_fov(kWidth, kHeight, std::numbers::pi_v<float> / 2);
+    depth_.points.max_range = 20.0f;
+  }
+
+  std::unique_ptr<PerceptionStage> make_stage() {
+    perception::PaletteOptions options;
+    options.confidence = 0.8f;
+    return std::make_unique<PerceptionStage>(
+        camera_, depth_,
+        std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(), kClasses,
+                                                       options),
+        colour_, &depth_ring_, poses_, clouds_);
+  }
+
+  void push_pair(double t, std::uint32_t sequence) {
+    colour_.try_push(colour_frame(t, sequence));
+    depth_ring_.try_push(depth_frame(t, sequence));
+  }
+
+  CameraConfig camera_;
+  DepthConfig depth_;
+  SpscRing<ImageFrame> colour_{8, OverflowPolicy::kDropOldest};
+  SpscRing<ImageFrame> depth_ring_{8, OverflowPolicy::kDropOldest};
+  SpscRing<LabeledCloud> clouds_{8, OverflowPolicy::kDropOldest};
+  SharedPoseHistory poses_{1024};
+};
+
+TEST_F(PerceptionStageTest, PosesLabelledPointsAtTheFrameStamp) {
+  auto stage = make_stage();
+  const auto poses = drive(1.0, 2.0);
+  poses_.append(poses);
+  push_pair(1.505, 7);
+  ASSERT_TRUE(stage->step());
+  LabeledCloud cloud;
+  ASSERT_TRUE(clouds_.try_pop(cloud));
+  EXPECT_EQ(cloud.stamp, at(1.505));
+  // Every pixel but the unknown-colour top row becomes a point.
+  ASSERT_EQ(cloud.size(), static_cast<std::size_t>(kWidth * (kHeight - 1)));
+  const auto s = stage->stats();
+  EXPECT_EQ(s.clouds, 1u);
+  EXPECT_EQ(s.dropped.no_label, static_cast<std::uint64_t>(kWidth));
+  EXPECT_EQ(s.points, cloud.size());
+
+  // The body was at x = 2 * 1.505 when the frame was taken (interpolated between poses).
+  const Eigen::Isometry3f body_from_optical = camera_.body_from_optical();
+  const Eigen::Vector3f body(3.01f, 0.0f, 0.0f);
+  EXPECT_NEAR((cloud.origin - (body + body_from_optical.translation())).norm(), 0.0f, 1e-4f);
+  const auto& k = camera_.intrinsics;
+  // First point: pixel (0, 1), the first row with a label.
+  const Eigen::Vector3f optical = k.ray(0.0f, 1.0f) * kDepth;
+  EXPECT_NEAR((cloud.points.front() - (body + body_from_optical * optical)).norm(), 0.0f, 1e-3f);
+  // Soft labels: the palette's confidence on road's map class, the rest spread.
+  ASSERT_EQ(cloud.num_classes, kClasses);
+  ASSERT_EQ(cloud.probabilities.size(), cloud.size() * kClasses);
+  EXPECT_FLOAT_EQ(cloud.probabilities[1], 0.8f);
+  EXPECT_FLOAT_EQ(cloud.probabilities[0], 0.0f);
+  EXPECT_NEAR(cloud.probabilities[2] + cloud.probabilities[3], 0.2f, 1e-6f);
+}
+
+TEST_F(PerceptionStageTest, WaitsForTheFilterToReachTheFrame) {
+  auto stage = make_stage();
+  poses_.append(drive(1.0, 2.0));
+  push_pair(2.5, 1);
+  stage->step();
+  EXPECT_TRUE(clouds_.empty());  // newer than the filter: held, not dropped
+  EXPECT_EQ(stage->stats().without_pose, 0u);
+  poses_.append(drive(2.01, 3.0));
+  stage->step();
+  LabeledCloud cloud;
+  ASSERT_TRUE(clouds_.try_pop(cloud));
+  EXPECT_NEAR(cloud.origin.x() - camera_.mount_xyz.x(), 5.0f, 1e-3f);
+}
+
+TEST_F(PerceptionStageTest, CountsFramesWithoutAPose) {
+  auto stage = make_stage();
+  push_pair(0.5, 1);  // no filter yet
+  stage->step();
+  poses_.append(drive(1.0, 2.0));
+  push_pair(0.9, 2);  // older than the history
+  stage->step();
+  EXPECT_TRUE(clouds_.empty());
+  EXPECT_EQ(stage->stats().without_pose, 2u);
+  EXPECT_EQ(stage->stats().clouds, 0u);
+}
+
+TEST_F(PerceptionStageTest, TakesTheNewestFrameWhenBehind) {
+  auto stage = make_stage();
+  poses_.append(drive(1.0, 2.0));
+  push_pair(1.1, 1);
+  push_pair(1.2, 2);
+  push_pair(1.3, 3);
+  stage->step();
+  LabeledCloud cloud;
+  ASSERT_TRUE(clouds_.try_pop(cloud));
+  EXPECT_EQ(cloud.stamp, at(1.3));
+  EXPECT_FALSE(clouds_.try_pop(cloud));
+  EXPECT_EQ(stage->stats().skipped, 2u);
+  EXPECT_EQ(stage->stats().frames, 3u);
+}
+
+TEST_F(PerceptionStageTest, PairsColourAndDepthByStampWithinTheTolerance) {
+  auto stage = make_stage();
+  poses_.append(drive(1.0, 2.0));
+  colour_.try_push(colour_frame(1.10, 1));
+  depth_ring_.try_push(depth_frame(1.15, 1));  // 50 ms off: beyond the 20 ms tolerance
+  stage->step();
+  EXPECT_TRUE(clouds_.empty());
+  colour_.try_push(colour_frame(1.20, 2));
+  depth_ring_.try_push(depth_frame(1.21, 2));  // 10 ms off: pairs
+  stage->step();
+  LabeledCloud cloud;
+  ASSERT_TRUE(clouds_.try_pop(cloud));
+  EXPECT_EQ(cloud.stamp, at(1.20));
+  const auto s = stage->stats();
+  // The 1.10 colour frame is passed over for the newer pair, the 1.15 depth frame unpaired.
+  EXPECT_EQ(s.skipped + s.unpaired, 2u);
+  EXPECT_EQ(s.clouds, 1u);
+}
+
+TEST_F(PerceptionStageTest, RejectsBadFramesAndKeepsGoing) {
+  auto stage = make_stage();
+  poses_.append(drive(1.0, 2.0));
+  colour_.try_push(colour_frame(1.1, 1));
+  depth_ring_.try_push(depth_frame(1.1, 1, kWidth / 2));  // wrong size
+  stage->step();
+  auto truncated = colour_frame(1.2, 2);
+  truncated.data.resize(10);
+  colour_.try_push(truncated);
+  depth_ring_.try_push(depth_frame(1.2, 2));
+  stage->step();
+  EXPECT_EQ(stage->stats().bad_frames, 2u);
+  EXPECT_TRUE(clouds_.empty());
+  push_pair(1.3, 3);
+  stage->step();
+  EXPECT_EQ(stage->stats().clouds, 1u);
+}
+
+TEST_F(PerceptionStageTest, RefusesAlignedDepthWithoutADepthRing) {
+  EXPECT_THROW(PerceptionStage(camera_, depth_,
+                               std::make_unique<perception::PaletteSegmenter>(
+                                   perception::cityscapes_palette(), kClasses),
+                               colour_, nullptr, poses_, clouds_),
+               std::invalid_argument);  // aligned depth without a depth ring
+}
+
+// The stage's own thread against a producer thread and the pose writer, as on the robot.
+TEST_F(PerceptionStageTest, RunsOnItsThreadWhileDriversPush) {
+  auto stage = make_stage();
+  stage->start();
+  std::jthread filter([this] {
+    for (int i = 0; i < 50; ++i) {
+      poses_.append(drive(1.0 + 0.02 * i, 1.0 + 0.02 * i + 0.019));
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+  for (int i = 0; i < 40; ++i) {
+    push_pair(1.0 + 0.025 * i, static_cast<std::uint32_t>(i));
+    std::this_thread::sleep_for(std::chrono::milliseconds(3));
+  }
+  filter.join();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (stage->stats().clouds + stage->stats().skipped + stage->stats().without_pose < 40 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  stage->stop();
+  const auto s = stage->stats();
+  EXPECT_EQ(s.frames, 40u);
+  EXPECT_EQ(s.clouds + s.skipped + s.without_pose + colour_.counters().drops(), 40u);
+  EXPECT_GT(s.clouds, 0u);
+  EXPECT_EQ(s.bad_frames, 0u);
+}
+
+}  // namespace
+}  // namespace semap::onboard
