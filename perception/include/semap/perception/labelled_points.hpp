@@ -28,10 +28,10 @@ struct DropCounts {
 
 // How labelled pixels become points, shared by the depth, stereo and LiDAR paths.
 struct PointOptions {
-  int stride = 1;                // use every stride-th pixel in u and v (depth and stereo)
-  float max_range = 20.0f;       // metres from the sensor
-  float min_confidence = 0.0f;   // pixels whose top class is less likely are dropped
-  bool soft_labels = true;       // copy the segmenter's probabilities when it gives them
+  int stride = 1;               // use every stride-th pixel in u and v (depth and stereo)
+  float max_range = 20.0f;      // metres from the sensor
+  float min_confidence = 0.0f;  // pixels whose top class is less likely are dropped
+  bool soft_labels = true;      // copy the segmenter's probabilities when it gives them
 };
 
 }  // namespace semap::perception
