@@ -1,0 +1,125 @@
+// semap-onboard's configuration: the shipped examples load as documented, and a bad camera,
+// depth or segmenter section stops start-up with the file and key named.
+#include "onboard_config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "segmenter_factory.hpp"
+#include "semap/common/config.hpp"
+
+namespace semap::onboard {
+namespace {
+
+const std::filesystem::path kConfigDir = std::filesystem::path(SEMAP_SOURCE_DIR) / "config";
+
+// sim.yaml with `replace` swapped for `with`, written to a temporary file.
+std::filesystem::path edited_sim(const std::string& replace, const std::string& with) {
+  std::ifstream in(kConfigDir / "sim.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(replace);
+  EXPECT_NE(at, std::string::npos) << replace;
+  text.replace(at, replace.size(), with);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("semap_onboard_config_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string error_of(const std::filesystem::path& path) {
+  std::string error = "no error";
+  try {
+    load_onboard_config(path);
+  } catch (const common::ConfigError& e) {
+    error = e.what();
+  }
+  std::filesystem::remove(path);
+  return error;
+}
+
+TEST(OnboardConfig, SimulatedRigExample) {
+  const auto c = load_onboard_config(kConfigDir / "sim.yaml");
+  EXPECT_TRUE(c.rig.simulated);
+  EXPECT_EQ(c.camera.intrinsics.width, 96);
+  EXPECT_EQ(c.camera.intrinsics.height, 64);
+  EXPECT_DOUBLE_EQ(c.camera.driver.fps, 5.0);
+  EXPECT_EQ(c.depth.source, DepthSource::kAligned);
+  // Aligned depth takes the colour camera's size unless the file says otherwise.
+  EXPECT_EQ(c.depth.driver.width, 96u);
+  EXPECT_EQ(c.depth.driver.format, common::PixelFormat::kZ16);
+  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kPalette);
+  EXPECT_FLOAT_EQ(c.segmenter.confidence, 0.9f);
+  const auto segmenter = make_segmenter(c.segmenter, c.map.num_classes);
+  EXPECT_EQ(segmenter->num_classes(), c.map.num_classes);
+}
+
+TEST(OnboardConfig, RgbdRobotExample) {
+  const auto c = load_onboard_config(kConfigDir / "robot-rgbd.yaml");
+  EXPECT_FALSE(c.rig.simulated);
+  EXPECT_EQ(c.camera.driver.device, "/dev/video0");
+  EXPECT_EQ(c.camera.driver.format, common::PixelFormat::kYuyv);
+  EXPECT_FLOAT_EQ(c.camera.intrinsics.fx, 615.0f);
+  EXPECT_FLOAT_EQ(c.camera.intrinsics.cy, 239.5f);
+  EXPECT_EQ(c.depth.driver.device, "/dev/video2");
+  EXPECT_FLOAT_EQ(c.depth.depth_scale, 0.001f);
+  EXPECT_EQ(c.depth.points.stride, 2);
+  EXPECT_FLOAT_EQ(c.depth.points.min_confidence, 0.5f);
+  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
+  EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
+  // Pitched 10 degrees down: the optical axis points forward and down.
+  const Eigen::Vector3f axis = c.camera.body_from_optical().linear() * Eigen::Vector3f::UnitZ();
+  EXPECT_GT(axis.x(), 0.98f);
+  EXPECT_LT(axis.z(), -0.17f);
+}
+
+TEST(OnboardConfig, StereoRobotExample) {
+  const auto c = load_onboard_config(kConfigDir / "robot-stereo.yaml");
+  EXPECT_EQ(c.depth.source, DepthSource::kStereo);
+  EXPECT_TRUE(std::filesystem::exists(c.depth.stereo_calibration));
+  EXPECT_EQ(c.depth.stereo.num_disparities, 64);
+  EXPECT_EQ(c.camera.driver.format, common::PixelFormat::kMjpeg);
+  EXPECT_EQ(c.camera.driver.width, 1280u);
+}
+
+TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
+  EXPECT_NE(error_of(edited_sim("fov_deg: 90", "fov_deg: 90\n  ring: 6"))
+                .find("camera.ring': 6 is not a power of two"),
+            std::string::npos);
+  EXPECT_NE(error_of(edited_sim("source: aligned", "source: aligned\n  format: YUYV"))
+                .find("depth.format"),
+            std::string::npos);
+  EXPECT_NE(error_of(edited_sim("source: aligned", "source: aligned\n  width: 64"))
+                .find("aligned depth of 64x64 does not match the camera's 96x64"),
+            std::string::npos);
+  EXPECT_NE(error_of(edited_sim("source: aligned", "source: stereo")).find("depth.calibration"),
+            std::string::npos);
+  EXPECT_NE(error_of(edited_sim("source: aligned\n  depth_scale: 0.001",
+                                "source: stereo\n  calibration: x.yaml"))
+                .find("the simulated rig renders aligned depth only"),
+            std::string::npos);
+  EXPECT_NE(error_of(edited_sim("kind: palette", "kind: onnx")).find("segmenter.model_card"),
+            std::string::npos);
+  EXPECT_NE(error_of(edited_sim("confidence: 0.9", "confidence: 0.9\n  colour: red"))
+                .find("segmenter.colour"),
+            std::string::npos);
+}
+
+TEST(OnboardConfig, SegmenterMustFitTheMap) {
+  SegmenterConfig palette;
+  // The built-in Cityscapes mapping feeds map classes up to 3: a 3-class map cannot take it.
+  EXPECT_THROW(make_segmenter(palette, 3), std::invalid_argument);
+  SegmenterConfig onnx;
+  onnx.kind = SegmenterConfig::Kind::kOnnx;
+  onnx.model_card = "/nonexistent/card.yaml";
+  try {
+    make_segmenter(onnx, 4);
+    FAIL() << "no error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/card.yaml"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace semap::onboard
