@@ -144,23 +144,30 @@ int run(const semap::onboard::OnboardConfig& config) {
   }
 
   // On hardware the camera is optional (an empty camera.device): without it the robot still
-  // estimates and publishes its pose, and its map stays empty.
+  // estimates and publishes its pose, and its map stays empty. A segmenter or calibration that
+  // does not load leaves the robot in the same state, with the error logged: localisation must
+  // not depend on the camera half.
   const bool camera = rig || !config.camera.driver.device.empty();
+  std::unique_ptr<onboard::PerceptionStage> perception_stage;
+  if (camera) {
+    try {
+      perception_stage = std::make_unique<onboard::PerceptionStage>(
+          config.camera, config.depth,
+          onboard::make_segmenter(config.segmenter, config.map.num_classes), colour_ring,
+          config.depth.source == onboard::DepthSource::kAligned ? &depth_ring : nullptr, poses,
+          cloud_ring);
+      log->info("perception: {}", perception_stage->describe());
+    } catch (const std::exception& e) {
+      log->error("perception disabled, running without a map: {}", e.what());
+    }
+  }
   std::unique_ptr<drivers::CameraDriver> camera_driver;
   std::unique_ptr<drivers::CameraDriver> depth_driver;
-  if (camera && !rig) {
+  if (perception_stage && !rig) {
     camera_driver = std::make_unique<drivers::CameraDriver>(config.camera.driver, colour_ring);
     if (config.depth.source == onboard::DepthSource::kAligned) {
       depth_driver = std::make_unique<drivers::CameraDriver>(config.depth.driver, depth_ring);
     }
-  }
-  std::unique_ptr<onboard::PerceptionStage> perception_stage;
-  if (camera) {
-    perception_stage = std::make_unique<onboard::PerceptionStage>(
-        config.camera, config.depth,
-        onboard::make_segmenter(config.segmenter, config.map.num_classes), colour_ring,
-        config.depth.source == onboard::DepthSource::kAligned ? &depth_ring : nullptr, poses,
-        cloud_ring);
   }
 
   std::unique_ptr<onboard::DdsOutputs> dds;

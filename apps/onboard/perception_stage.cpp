@@ -15,7 +15,7 @@ namespace {
 
 constexpr std::size_t kMaxUnposed = 8;  // clouds waiting for the filter to reach their stamp
 
-std::string describe(const common::ImageFrame& f) {
+std::string frame_name(const common::ImageFrame& f) {
   return "frame " + std::to_string(f.sequence) + " (" + std::to_string(f.width) + "x" +
          std::to_string(f.height) + ", stamp " + std::to_string(f.stamp.ns) + " ns)";
 }
@@ -80,6 +80,12 @@ PerceptionStageStats PerceptionStage::stats() const {
 std::uint32_t PerceptionStage::queue_depth() const {
   const std::size_t depth = depth_ring_ ? depth_ring_->size() : 0;
   return static_cast<std::uint32_t>(colour_ring_.size() + depth);
+}
+
+std::string PerceptionStage::describe() const {
+  const std::string depth =
+      stereo_ ? "stereo (" + depth_.stereo_calibration.string() + ")" : "aligned Z16 depth";
+  return segmenter_->describe() + ", " + depth;
 }
 
 void PerceptionStage::run(std::stop_token stop) {
@@ -179,7 +185,7 @@ void PerceptionStage::reject(const common::ImageFrame& frame, const std::string&
   // hundredth, each with its count.
   if (local_.bad_frames <= 5 || local_.bad_frames % 100 == 0) {
     common::logger("perception")
-        ->warn("{} rejected ({} so far): {}", describe(frame), local_.bad_frames, why);
+        ->warn("{} rejected ({} so far): {}", frame_name(frame), local_.bad_frames, why);
   }
 }
 

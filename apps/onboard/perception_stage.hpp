@@ -55,6 +55,8 @@ class PerceptionStage {
   // Age of each frame (its capture stamp) when its posed cloud goes to the mapping stage.
   const LatencyWindow& latency() const { return latency_; }
   std::uint32_t queue_depth() const;
+  // The segmenter and depth source, for the log.
+  std::string describe() const;
 
   // One round of the stage's loop, for tests that drive it without its thread: takes what
   // the rings hold, processes at most one frame, poses what the filter has reached.
