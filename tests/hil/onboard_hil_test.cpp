@@ -1,0 +1,452 @@
+// semap-onboard, the robot's main job, on a hardware configuration against kernel devices:
+// IMU CAN frames on vcan0 and GNSS NMEA on a pty from semap-sensor-sim, the vivid virtual
+// camera as a side-by-side stereo camera (depth by semi-global matching) and an ONNX segmenter.
+// Natively where the host has vcan0 and vivid, otherwise inside scripts/hil-qemu, which copies
+// both programs next to this binary (see docs/hil.md).
+#include <fcntl.h>
+#include <linux/videodev2.h>
+#include <signal.h>
+#include <sys/ioctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "hil_env.hpp"
+#include "semap/drivers/driver_error.hpp"
+#include "semap/drivers/v4l2_device.hpp"
+#include "support/onnx_writer.hpp"
+
+namespace semap::drivers {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+constexpr double kRunSeconds = 20.0;  // semap-onboard --duration
+
+// The first vivid video capture node, or "" when there is none.
+std::string find_vivid() {
+  for (int i = 0; i < 16; ++i) {
+    const std::string path = "/dev/video" + std::to_string(i);
+    try {
+      V4l2Device dev(path);
+      if (dev.driver() == "vivid") return path;
+    } catch (const DriverError&) {
+      // not a capture node, or no such device
+    }
+  }
+  return "";
+}
+
+// A program given to scripts/hil-qemu sits next to this binary; natively it is in the build tree.
+std::string find_program(const std::string& name, const std::string& built) {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec && fs::exists(self.parent_path() / name)) return (self.parent_path() / name).string();
+  return fs::exists(built) ? built : "";
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path write_file(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+  return path;
+}
+
+// A child process with stdout and stderr in one file.
+class Child {
+ public:
+  Child(const std::vector<std::string>& argv, const fs::path& output) : output_(output) {
+    const int fd = ::open(output.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw std::runtime_error("cannot create " + output.string());
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(fd, STDOUT_FILENO);
+      ::dup2(fd, STDERR_FILENO);
+      ::execv(args[0], args.data());
+      std::perror(args[0]);
+      ::_exit(127);
+    }
+    ::close(fd);
+    if (pid_ < 0) throw std::runtime_error("fork failed");
+  }
+  ~Child() {
+    if (running()) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  bool running() { return pid_ > 0 && !poll(); }
+  // The exit code (128 + signal when killed), or nothing while it still runs after `timeout`.
+  std::optional<int> wait(std::chrono::milliseconds timeout) {
+    hil::wait_until([&] { return poll().has_value(); }, timeout);
+    return status_;
+  }
+  // SIGTERM, then SIGKILL if it does not exit within `grace`.
+  int stop(std::chrono::milliseconds grace) {
+    if (running()) ::kill(pid_, SIGTERM);
+    if (auto code = wait(grace)) return *code;
+    ::kill(pid_, SIGKILL);
+    return wait(5s).value_or(-1);
+  }
+  std::string output() const { return read_file(output_); }
+
+ private:
+  const std::optional<int>& poll() {
+    int status = 0;
+    if (!status_ && ::waitpid(pid_, &status, WNOHANG) == pid_) {
+      status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    return status_;
+  }
+
+  fs::path output_;
+  pid_t pid_ = -1;
+  std::optional<int> status_;
+};
+
+// Sets a menu control of the device by its name and the name of the item; returns the control's
+// id and the value it had, to restore it.
+std::optional<std::pair<std::uint32_t, std::int32_t>> set_menu_control(int fd,
+                                                                       const std::string& control,
+                                                                       const std::string& item,
+                                                                       std::string& error) {
+  v4l2_queryctrl q{};
+  q.id = V4L2_CTRL_FLAG_NEXT_CTRL;
+  while (::ioctl(fd, VIDIOC_QUERYCTRL, &q) == 0) {
+    if (control == reinterpret_cast<const char*>(q.name) && q.type == V4L2_CTRL_TYPE_MENU) {
+      std::string items;
+      for (auto i = q.minimum; i <= q.maximum; ++i) {
+        v4l2_querymenu m{};
+        m.id = q.id;
+        m.index = static_cast<std::uint32_t>(i);
+        if (::ioctl(fd, VIDIOC_QUERYMENU, &m) != 0) continue;
+        const std::string name = reinterpret_cast<const char*>(m.name);
+        items += "'" + name + "' ";
+        if (name != item) continue;
+        v4l2_control c{};
+        c.id = q.id;
+        if (::ioctl(fd, VIDIOC_G_CTRL, &c) != 0) break;
+        const std::int32_t old = c.value;
+        c.value = i;
+        if (::ioctl(fd, VIDIOC_S_CTRL, &c) != 0) {
+          error = control + ": VIDIOC_S_CTRL: " + std::strerror(errno);
+          return std::nullopt;
+        }
+        return std::pair{q.id, old};
+      }
+      error = control + ": no item '" + item + "' among " + items;
+      return std::nullopt;
+    }
+    q.id |= V4L2_CTRL_FLAG_NEXT_CTRL;
+  }
+  error = "no menu control '" + control + "'";
+  return std::nullopt;
+}
+
+// The smallest YUYV size vivid offers that is at least 320 wide (its webcam input lists
+// discrete sizes: 320x180, 640x360, 640x480, ...).
+std::pair<std::uint32_t, std::uint32_t> smallest_yuyv_size(int fd) {
+  std::pair<std::uint32_t, std::uint32_t> best{640, 480};
+  v4l2_frmsizeenum f{};
+  f.pixel_format = V4L2_PIX_FMT_YUYV;
+  for (f.index = 0; ::ioctl(fd, VIDIOC_ENUM_FRAMESIZES, &f) == 0; ++f.index) {
+    if (f.type != V4L2_FRMSIZE_TYPE_DISCRETE) return {320, 240};
+    const auto w = f.discrete.width, h = f.discrete.height;
+    if (w >= 320 && w % 4 == 0 && w * h < best.first * best.second) best = {w, h};
+  }
+  return best;
+}
+
+// The figures the test checks, from semap-onboard's summary.
+struct Summary {
+  bool initialised = false;
+  unsigned long imu_samples = 0, gnss_fixes = 0;
+  unsigned long camera_frames = 0, camera_bad = 0;
+  unsigned long perception_frames = 0, clouds = 0, cloud_points = 0, perception_bad = 0;
+  unsigned long scans = 0, blocks = 0;
+  std::string missing;  // summary lines not found
+};
+
+Summary parse_summary(const std::string& out) {
+  Summary s;
+  std::smatch m;
+  const auto find = [&](const char* name, const std::regex& re) {
+    if (std::regex_search(out, m, re)) return true;
+    s.missing += std::string(name) + " ";
+    return false;
+  };
+  if (find("estimation",
+           std::regex(R"(estimation +: (\d+) IMU samples, (\d+) GNSS fixes.*initialised=(\w+))"))) {
+    s.imu_samples = std::stoul(m[1]);
+    s.gnss_fixes = std::stoul(m[2]);
+    s.initialised = m[3] == "yes";
+  }
+  if (find("camera driver", std::regex(R"(camera driver +: (\d+) frames, (\d+) bad)"))) {
+    s.camera_frames = std::stoul(m[1]);
+    s.camera_bad = std::stoul(m[2]);
+  }
+  if (find("perception", std::regex(R"(perception +: (\d+) frames, (\d+) clouds mapped \((\d+) )"
+                                    R"(points\), \d+ passed over, \d+ unpaired, (\d+) bad)"))) {
+    s.perception_frames = std::stoul(m[1]);
+    s.clouds = std::stoul(m[2]);
+    s.cloud_points = std::stoul(m[3]);
+    s.perception_bad = std::stoul(m[4]);
+  }
+  if (find("mapping", std::regex(R"(mapping +: (\d+) scans, .*, (\d+) blocks,)"))) {
+    s.scans = std::stoul(m[1]);
+    s.blocks = std::stoul(m[2]);
+  }
+  return s;
+}
+
+class OnboardHil : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    onboard_ = find_program("semap-onboard", SEMAP_ONBOARD_BIN);
+    sensor_sim_ = find_program("semap-sensor-sim", SEMAP_SENSOR_SIM_BIN);
+    ASSERT_FALSE(onboard_.empty()) << "semap-onboard not found";
+    ASSERT_FALSE(sensor_sim_.empty()) << "semap-sensor-sim not found";
+    if (!fs::exists("/sys/class/net/vcan0")) SEMAP_HIL_UNAVAILABLE("no vcan0 interface");
+    camera_ = find_vivid();
+    if (camera_.empty()) SEMAP_HIL_UNAVAILABLE("no vivid capture device (modprobe vivid)");
+    dir_ = fs::temp_directory_path() / ("semap_onboard_hil_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+
+  void TearDown() override {
+    if (fd_ >= 0) {
+      // Leave vivid as it was for whatever runs next.
+      for (const auto& [id, value] : restore_) {
+        v4l2_control c{id, value};
+        ::ioctl(fd_, VIDIOC_S_CTRL, &c);
+      }
+      ::close(fd_);
+    }
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+
+  // Checkers give the matcher texture, and with its on-screen text off both halves of the frame
+  // show the same pattern.
+  void set_vivid_pattern() {
+    fd_ = ::open(camera_.c_str(), O_RDWR | O_CLOEXEC);
+    ASSERT_GE(fd_, 0) << camera_ << ": " << std::strerror(errno);
+    const auto set = [&](const std::string& control, const std::string& item, bool required) {
+      std::string error;
+      if (const auto old = set_menu_control(fd_, control, item, error)) {
+        restore_.push_back(*old);
+        std::printf("vivid: %s = %s\n", control.c_str(), item.c_str());
+      } else if (required) {
+        FAIL() << camera_ << ": " << error;
+      } else {
+        std::printf("vivid: %s left as is (%s)\n", control.c_str(), error.c_str());
+      }
+    };
+    set("Test Pattern", "16x16 Checkers", true);
+    set("OSD Text Mode", "None", false);
+  }
+
+  std::string onboard_, sensor_sim_, camera_;
+  fs::path dir_;
+  int fd_ = -1;
+  std::vector<std::pair<std::uint32_t, std::int32_t>> restore_;
+};
+
+// The stereo calibration of the side-by-side frame. vivid shows the same checkers in both
+// halves (the pattern's period divides the half width), which a rectified pair would see only
+// at infinite range. The right camera's principal point lies `shift` pixels right of the left
+// one's, so after rectification (common principal point) every pixel has disparity ~ shift:
+// the rig sees a textured plane at Z = f B / shift (here ~2 m).
+std::string stereo_calibration(std::uint32_t half_width, std::uint32_t half_height, double shift) {
+  const double f = half_width;
+  const double cx = (half_width - 1) / 2.0, cy = (half_height - 1) / 2.0;
+  const auto matrix = [](int rows, int cols, const std::string& data) {
+    return "!!opencv-matrix\n   rows: " + std::to_string(rows) +
+           "\n   cols: " + std::to_string(cols) + "\n   dt: d\n   data: [ " + data + " ]\n";
+  };
+  const auto camera = [&](double cx_px) {
+    std::ostringstream s;
+    s << f << ", 0., " << cx_px << ", 0., " << f << ", " << cy << ", 0., 0., 1.";
+    return matrix(3, 3, s.str());
+  };
+  return "%YAML:1.0\n---\nimage_width: " + std::to_string(half_width) +
+         "\nimage_height: " + std::to_string(half_height) + "\nM1: " + camera(cx) +
+         "D1: " + matrix(1, 5, "0., 0., 0., 0., 0.") + "M2: " + camera(cx + shift) +
+         "D2: " + matrix(1, 5, "0., 0., 0., 0., 0.") +
+         "R: " + matrix(3, 3, "1., 0., 0., 0., 1., 0., 0., 0., 1.") +
+         "T: " + matrix(3, 1, "-0.1, 0., 0.");
+}
+
+// A 1x1-convolution network at the size of one half: bright pixels are "light" (map class 1),
+// dark ones "dark" (2), mid grey "grey" (3). Inputs are pixel / 255 (mean 0, std 1).
+// GCC 12 at -O3 reports a false -Wrestrict inside the inlined std::string concatenations of
+// the ONNX writer (GCC bug 105329).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wrestrict"
+#endif
+void write_segmenter(const fs::path& dir, std::uint32_t width, std::uint32_t height) {
+  const std::vector<float> weights = {4, 4, 4, -4, -4, -4, 0, 0, 0};
+  const std::vector<float> bias = {-6, 6, 0};
+  test::write_bytes(
+      dir / "net.onnx",
+      test::affine_pixel_model(static_cast<int>(height), static_cast<int>(width), weights, bias));
+  std::ostringstream card;
+  card << "model: net.onnx\n"
+       << "input:\n"
+       << "  width: " << width << "\n"
+       << "  height: " << height << "\n"
+       << "  channel_order: rgb\n"
+       << "  mean: [0, 0, 0]\n"
+       << "  std: [1, 1, 1]\n"
+       << "output: logits\n"
+       << "threads: 1\n"
+       << "model_classes:\n"
+       << "  names: [light, dark, grey]\n"
+       << "  colors: [255, 255, 255, 0, 0, 0, 128, 128, 128]\n"
+       << "map:\n"
+       << "  num_classes: 4\n"
+       << "  unmapped: drop\n"
+       << "  from_model: {light: 1, dark: 2, grey: 3}\n";
+  write_file(dir / "card.yaml", card.str());
+}
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+// The robot's configuration: config/robot-stereo.yaml with the VM's devices, DDS off.
+std::string onboard_config(const fs::path& dir, const std::string& camera, std::uint32_t width,
+                           std::uint32_t height, const std::string& gnss_device) {
+  std::ostringstream c;
+  c << "log_level: info\n"
+    << "rig:\n"
+    << "  kind: hardware\n"
+    << "imu:\n"
+    << "  interface: vcan0\n"
+    << "  profile: semap\n"
+    << "gnss:\n"
+    << "  device: " << gnss_device << "\n"
+    << "  baud: 115200\n"
+    << "  protocol: nmea\n"
+    << "camera:\n"
+    << "  device: " << camera << "\n"
+    << "  format: YUYV\n"
+    << "  width: " << width << "\n"
+    << "  height: " << height << "\n"
+    << "  fps: 10\n"
+    << "  mount_xyz: [0.3, 0, 1.0]\n"
+    << "  mount_rpy_deg: [0, 10, 0]\n"
+    << "depth:\n"
+    << "  source: stereo\n"
+    << "  calibration: " << (dir / "stereo.yaml").string() << "\n"
+    << "  num_disparities: 16\n"
+    << "  block_size: 5\n"
+    << "  stride: 2\n"
+    << "  max_range: 10\n"
+    << "  min_confidence: 0.5\n"
+    << "segmenter:\n"
+    << "  kind: onnx\n"
+    << "  model_card: " << (dir / "card.yaml").string() << "\n"
+    << "map:\n"
+    << "  method: bki\n"
+    << "  resolution: 0.2\n"
+    << "  block_depth: 3\n"
+    << "  num_classes: 4\n"
+    << "  sf2: 10\n"
+    << "  ell: 0.5\n"
+    << "  prior: 0.001\n"
+    << "  free_res: 1.0\n"
+    << "  ds_res: 0.2\n"
+    << "  max_range: 10\n"
+    << "  threads: 1\n"
+    << "dds:\n"
+    << "  enabled: false\n";
+  return c.str();
+}
+
+TEST_F(OnboardHil, MapsFromVividStereoWithImuOnVcanAndGnssOnPty) {
+  ASSERT_NO_FATAL_FAILURE(set_vivid_pattern());
+  const auto [width, height] = smallest_yuyv_size(fd_);
+  const std::uint32_t half = width / 2;
+  std::printf("camera %s: YUYV %ux%u, two %ux%u halves\n", camera_.c_str(), width, height, half,
+              height);
+  write_file(dir_ / "stereo.yaml", stereo_calibration(half, height, 8.0));
+  write_segmenter(dir_, half, height);
+  // A slow circle: 1 m/s, 0.05 rad/s; IMU at 200 Hz, GNSS at 5 Hz.
+  write_file(dir_ / "trajectory.yaml",
+             "trajectory:\n  speed_mps: 1.0\n  yaw_rate_rad_s: 0.05\n  imu_rate_hz: 200\n"
+             "  gnss_rate_hz: 5\n  gnss_sigma_m: 0.3\n");
+
+  Child sim({sensor_sim_, "--can-if", "vcan0", "--pty", "--config",
+             (dir_ / "trajectory.yaml").string(), "--duration", std::to_string(kRunSeconds + 120)},
+            dir_ / "sensor-sim.log");
+  std::smatch m;
+  std::string sim_out;
+  const bool pty = hil::wait_until(
+      [&] {
+        sim_out = sim.output();
+        return std::regex_search(sim_out, m, std::regex(R"(pty (/dev/pts/\d+))")) || !sim.running();
+      },
+      20s);
+  ASSERT_TRUE(pty && m.size() == 2) << "semap-sensor-sim printed no pty:\n" << sim_out;
+  const std::string gnss_device = m[1];
+  std::printf("semap-sensor-sim: IMU on vcan0, GNSS on %s\n", gnss_device.c_str());
+
+  write_file(dir_ / "onboard.yaml", onboard_config(dir_, camera_, width, height, gnss_device));
+
+  const auto started = std::chrono::steady_clock::now();
+  Child onboard({onboard_, "--config", (dir_ / "onboard.yaml").string(), "--duration",
+                 std::to_string(kRunSeconds)},
+                dir_ / "onboard.log");
+  const auto code =
+      onboard.wait(std::chrono::milliseconds(static_cast<int>(1e3 * kRunSeconds)) + 120s);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const int sim_code = sim.stop(10s);
+  const std::string out = onboard.output();
+  std::printf("---- semap-onboard (%.1f s) ----\n%s\n---- semap-sensor-sim ----\n%s\n", wall,
+              out.c_str(), sim.output().c_str());
+  std::fflush(stdout);
+
+  ASSERT_TRUE(code.has_value()) << "semap-onboard did not exit";
+  EXPECT_EQ(*code, 0);
+  EXPECT_EQ(sim_code, 0) << "semap-sensor-sim";
+  const Summary s = parse_summary(out);
+  ASSERT_TRUE(s.missing.empty()) << "summary lines missing: " << s.missing;
+  EXPECT_TRUE(s.initialised);
+  EXPECT_GT(s.imu_samples, 0u);
+  EXPECT_GT(s.gnss_fixes, 0u);
+  EXPECT_GT(s.camera_frames, 0u);
+  EXPECT_EQ(s.camera_bad, 0u);
+  EXPECT_GT(s.perception_frames, 0u);
+  EXPECT_EQ(s.perception_bad, 0u);
+  EXPECT_GT(s.clouds, 0u);
+  EXPECT_GT(s.cloud_points, 0u);
+  EXPECT_GT(s.scans, 0u);
+  EXPECT_GT(s.blocks, 0u);
+}
+
+}  // namespace
+}  // namespace semap::drivers
