@@ -106,13 +106,12 @@ std::vector<semap::onboard::StageFigures> stage_figures(
        {}},
   };
   if (perception) {
-    // Frames lost anywhere before the map: in the driver's ring, passed over, unpaired,
-    // unreadable or without a pose.
+    // Colour frames lost anywhere before the map: in the driver's ring, passed over,
+    // unpaired, unreadable or without a pose.
     const auto p = perception->stats();
-    figures.push_back(
-        {"perception", p.clouds, perception->queue_depth(),
-         drops(r.colour, r.depth) + p.skipped + p.unpaired + p.bad_frames + p.without_pose,
-         perception->latency().percentiles()});
+    figures.push_back({"perception", p.clouds, perception->queue_depth(),
+                       drops(r.colour) + p.skipped + p.unpaired + p.bad_frames + p.without_pose,
+                       perception->latency().percentiles()});
   }
   return figures;
 }

@@ -35,8 +35,11 @@ void read_rig(const ConfigSection& s, RigConfig& rig) {
   t.gnss_sigma_m = s.get_in_range("gnss_sigma_m", 0.5, 0.01, 10.0);
   t.static_s = s.get_in_range("static_s", 3.0, 1.0, 60.0);
   t.seed = static_cast<std::uint64_t>(s.get<int>("seed", 1));
-  rig.obstacles = static_cast<int>(s.get_in_range("obstacles", rig.obstacles, 0, 1000));
   rig.scene_seed = static_cast<std::uint32_t>(s.get<int>("scene_seed", 7));
+  rig.world_density = s.get_in_range("world_density", rig.world_density, 0.0, 4.0);
+  rig.camera_image = s.get_choice("camera_image", "rgb", {"rgb", "classes"}) == "rgb"
+                         ? SimCameraImage::kRgb
+                         : SimCameraImage::kClasses;
   s.finish();
 }
 

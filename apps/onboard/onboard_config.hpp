@@ -14,6 +14,7 @@
 #include "semap/firmware_bridge/emulator.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/semantic_layers.hpp"
+#include "sim_camera_feed.hpp"
 
 namespace semap::onboard {
 
@@ -22,8 +23,9 @@ struct RigConfig {
   bool simulated = true;
   double duration_s = 40.0;  // 0: run until SIGINT
   estimation::SimulatorConfig trajectory;
-  int obstacles = 60;
-  std::uint32_t scene_seed = 7;
+  std::uint32_t scene_seed = 7;  // the street world and the camera's noise
+  double world_density = 1.0;    // scales the number of buildings, trees, cars and poles
+  SimCameraImage camera_image = SimCameraImage::kRgb;
 };
 
 struct ImuSourceConfig {

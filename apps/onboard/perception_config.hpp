@@ -46,8 +46,9 @@ struct DepthConfig {
 struct SegmenterConfig {
   enum class Kind { kOnnx, kPalette } kind = Kind::kPalette;
   std::filesystem::path model_card;  // onnx
-  std::filesystem::path palette;     // palette: YAML file; empty = built-in Cityscapes palette
-  float confidence = 0.9f;           // palette: probability given to the colour's class
+  // palette: YAML file; empty = the Cityscapes colours of the simulated world's classes
+  std::filesystem::path palette;
+  float confidence = 0.9f;  // palette: probability given to the colour's class
 };
 
 }  // namespace semap::onboard

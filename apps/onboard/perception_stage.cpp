@@ -149,24 +149,24 @@ bool PerceptionStage::process_next() {
     const common::ImageFrame depth = std::move(*best);
     colour_pending_.erase(colour_pending_.begin(),
                           colour_pending_.begin() + static_cast<std::ptrdiff_t>(index) + 1);
-    // Depth frames up to the partner are used or too old for any later colour frame.
-    local_.unpaired += static_cast<std::uint64_t>(best - depth_pending_.begin());
+    // Depth frames before the partner are too old for any later colour frame.
+    local_.depth_unused += static_cast<std::uint64_t>(best - depth_pending_.begin());
     depth_pending_.erase(depth_pending_.begin(), best + 1);
     process(colour, &depth);
     return true;
   }
   // No pair yet: drop what can never pair (the other stream is already past it).
   const auto expire = [&](std::deque<common::ImageFrame>& mine,
-                          const std::deque<common::ImageFrame>& other) {
+                          const std::deque<common::ImageFrame>& other, std::uint64_t& count) {
     if (other.empty()) return;
     const common::Stamp horizon = other.back().stamp + (-tolerance);
     while (!mine.empty() && mine.front().stamp < horizon) {
       mine.pop_front();
-      ++local_.unpaired;
+      ++count;
     }
   };
-  expire(colour_pending_, depth_pending_);
-  expire(depth_pending_, colour_pending_);
+  expire(colour_pending_, depth_pending_, local_.unpaired);
+  expire(depth_pending_, colour_pending_, local_.depth_unused);
   // A depth device that stopped delivering must not let colour frames pile up.
   while (colour_pending_.size() > colour_ring_.capacity()) {
     colour_pending_.pop_front();
@@ -174,7 +174,7 @@ bool PerceptionStage::process_next() {
   }
   while (depth_pending_.size() > depth_ring_->capacity()) {
     depth_pending_.pop_front();
-    ++local_.unpaired;
+    ++local_.depth_unused;
   }
   return false;
 }

@@ -21,10 +21,12 @@ class StereoDepth;
 namespace semap::onboard {
 
 struct PerceptionStageStats {
+  // Counted in colour frames: each frame taken becomes a cloud or one of the losses below.
   std::uint64_t frames = 0;        // colour frames taken from the ring
   std::uint64_t clouds = 0;        // posed clouds handed to the mapping stage
   std::uint64_t skipped = 0;       // passed over for a newer frame (the stage fell behind)
-  std::uint64_t unpaired = 0;      // colour or depth frames without a partner in time
+  std::uint64_t unpaired = 0;      // no depth frame within the sync tolerance
+  std::uint64_t depth_unused = 0;  // depth frames no colour frame paired with
   std::uint64_t bad_frames = 0;    // undecodable, wrong format or wrong size
   std::uint64_t without_pose = 0;  // before the filter started, or older than its history
   std::uint64_t points = 0;        // labelled points handed on

@@ -6,6 +6,7 @@
 #include "semap/perception/model_card.hpp"
 #include "semap/perception/onnx_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
+#include "semap/perception/sim_classes.hpp"
 
 namespace semap::onboard {
 
@@ -24,7 +25,7 @@ std::unique_ptr<perception::Segmenter> make_segmenter(const SegmenterConfig& con
   perception::PaletteOptions options;
   options.confidence = config.confidence;
   auto palette = config.palette.empty()
-                     ? perception::cityscapes_palette()
+                     ? perception::cityscapes_palette(perception::sim_cityscapes_mapping())
                      : perception::load_palette_file(config.palette, map_classes);
   return std::make_unique<perception::PaletteSegmenter>(std::move(palette), map_classes, options);
 }

@@ -29,26 +29,18 @@ estimation::SimulationData simulate_drive(const OnboardConfig& config) {
   return estimation::simulate(sim);
 }
 
+perception::SimWorldOptions world_options(const RigConfig& rig) {
+  perception::SimWorldOptions o;
+  o.seed = rig.scene_seed;
+  o.density = static_cast<float>(rig.world_density);
+  return o;
+}
+
 std::vector<Eigen::Vector3d> path_of(const estimation::SimulationData& data) {
   std::vector<Eigen::Vector3d> path;
   path.reserve(data.truth.size());
   for (const auto& t : data.truth) path.push_back(t.state.position);
   return path;
-}
-
-// The colours the rig's camera paints each scene class with: the Cityscapes palette's road,
-// building and pole, and sky where nothing was hit, so the palette segmenter reads them back.
-struct SceneColour {
-  std::array<std::uint8_t, 3> bgr;
-};
-const SceneColour& scene_colour(std::uint16_t label) {
-  static const std::array<SceneColour, 4> colours = {{
-      {{180, 130, 70}},   // sky (no return)
-      {{128, 64, 128}},   // ground: road
-      {{70, 70, 70}},     // building
-      {{153, 153, 153}},  // pole
-  }};
-  return colours[std::min<std::size_t>(label, colours.size() - 1)];
 }
 
 void sleep_until(common::Stamp when, std::stop_token stop) {
@@ -68,13 +60,14 @@ SimRig::SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>&
                common::SpscRing<common::ImageFrame>& depth_ring)
     : config_(config),
       imu_ring_(imu_ring),
-      colour_ring_(colour_ring),
-      depth_ring_(depth_ring),
       data_(simulate_drive(config)),
-      scene_(perception::SyntheticScene::around_path(path_of(data_), 4.0f, config.rig.obstacles,
-                                                     config.rig.scene_seed)),
-      camera_(config.camera.intrinsics, config.depth.points.max_range),
+      world_(path_of(data_), world_options(config.rig)),
       body_from_optical_(config.camera.body_from_optical()) {
+  perception::SimCameraOptions camera;
+  camera.intrinsics = config.camera.intrinsics;
+  camera.seed = config.rig.scene_seed;
+  camera_ = std::make_unique<SimCameraFeed>(world_, camera, config.rig.camera_image,
+                                            config.depth.depth_scale, colour_ring, depth_ring);
   firmware_bridge::EmulatorConfig emu;
   emu.gnss_protocol = config.gnss.protocol;
   emu.speed = 0.0;  // the rig paces events itself
@@ -109,6 +102,7 @@ SimRig::~SimRig() {
 
 void SimRig::start() {
   start_ = common::Stamp::now() + 0.2;
+  camera_->start();
   thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
 }
 
@@ -117,6 +111,7 @@ void SimRig::stop() {
     thread_.request_stop();
     thread_.join();
   }
+  camera_->stop();
 }
 
 std::optional<estimation::TruthSample> SimRig::truth_at(common::Stamp stamp) const {
@@ -127,40 +122,11 @@ std::optional<estimation::TruthSample> SimRig::truth_at(common::Stamp stamp) con
   return *it;
 }
 
-void SimRig::render_image(const estimation::TruthSample& truth, common::Stamp stamp) {
+void SimRig::request_frame(const estimation::TruthSample& truth, common::Stamp stamp) {
   Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
   world_from_body.linear() = truth.state.rotation.cast<float>();
   world_from_body.translation() = truth.state.position.cast<float>();
-  const auto image = camera_.render(scene_, world_from_body * body_from_optical_, stamp);
-  const auto& k = config_.camera.intrinsics;
-  const auto pixels = static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height);
-
-  common::ImageFrame colour;
-  colour.stamp = stamp;
-  colour.sequence = sequence_;
-  colour.format = common::PixelFormat::kBgr24;
-  colour.width = static_cast<std::uint32_t>(k.width);
-  colour.height = static_cast<std::uint32_t>(k.height);
-  colour.stride = 3 * colour.width;
-  colour.data.resize(3 * pixels);
-  common::ImageFrame depth = colour;
-  depth.format = common::PixelFormat::kZ16;
-  depth.stride = 2 * depth.width;
-  depth.data.assign(2 * pixels, 0);
-  const float units_per_metre = 1.0f / config_.depth.depth_scale;
-  for (std::size_t i = 0; i < pixels; ++i) {
-    const float z = image.depth[i];
-    const bool hit = z > 0.0f;
-    const SceneColour& c = scene_colour(hit ? image.labels[i] : 0);
-    std::copy(c.bgr.begin(), c.bgr.end(), colour.data.begin() + static_cast<std::ptrdiff_t>(3 * i));
-    const auto units =
-        hit ? static_cast<std::uint16_t>(std::min(65535.0f, std::round(z * units_per_metre))) : 0;
-    std::memcpy(depth.data.data() + 2 * i, &units, sizeof units);
-  }
-  ++sequence_;
-  colour_ring_.try_push(std::move(colour));
-  depth_ring_.try_push(std::move(depth));
-  images_.fetch_add(1, std::memory_order_acq_rel);
+  camera_->request(world_from_body * body_from_optical_, stamp);
 }
 
 void SimRig::run(std::stop_token stop) {
@@ -187,15 +153,15 @@ void SimRig::run(std::stop_token stop) {
       }
       const auto& truth = data_.truth[std::min(imu_index++, data_.truth.size() - 1)];
       if (sim_stamp.seconds() >= next_camera) {
-        render_image(truth, wall);
+        request_frame(truth, wall);
         next_camera += camera_period;
       }
     } else if (pty_master_ >= 0) {
       emulator_->emit(*event);
     }
   }
-  log->info("simulated drive finished: {} IMU samples, {} GNSS epochs, {} images", imu_index,
-            emulator_->stats().gnss_epochs, images_.load());
+  log->info("simulated drive finished: {} IMU samples, {} GNSS epochs, {} frames rendered",
+            imu_index, emulator_->stats().gnss_epochs, camera_->rendered());
   finished_.store(true, std::memory_order_release);
 }
 

@@ -10,8 +10,8 @@
 #include "semap/estimation/simulator.hpp"
 #include "semap/firmware_bridge/emulator.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
-#include "semap/perception/synthetic_depth_camera.hpp"
-#include "semap/perception/synthetic_scene.hpp"
+#include "semap/perception/sim_world.hpp"
+#include "sim_camera_feed.hpp"
 
 namespace semap::onboard {
 
@@ -19,10 +19,10 @@ namespace semap::onboard {
 // bytes into a pseudo-terminal (read by the real GnssDriver through termios), IMU as CAN
 // frames on a SocketCAN interface when one is configured (read by the real CanImuDriver) or
 // straight into the IMU ring otherwise, and camera frames of a synthetic world seen from the
-// true pose: a colour frame whose colours encode the classes (Cityscapes palette, for the
-// palette segmenter) and an aligned Z16 depth frame, into the rings a colour camera driver
-// and a depth camera driver would fill. Sensor stamps are CLOCK_MONOTONIC, as real drivers
-// would give them.
+// true pose in a procedural street world (SimWorld): a colour frame, rendered or painted in
+// class colours (rig.camera_image), and an aligned Z16 depth frame, into the rings a colour
+// camera driver and a depth camera driver would fill (SimCameraFeed). Sensor stamps are
+// CLOCK_MONOTONIC, as real drivers would give them.
 class SimRig {
  public:
   SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu_ring,
@@ -42,21 +42,19 @@ class SimRig {
   // Truth at a monotonic stamp (nearest simulated sample), in the simulator's ENU frame.
   std::optional<estimation::TruthSample> truth_at(common::Stamp stamp) const;
   const estimation::SimulationData& data() const { return data_; }
-  const perception::SyntheticScene& scene() const { return scene_; }
+  const perception::SimWorld& world() const { return world_; }
+  const SimCameraFeed& camera() const { return *camera_; }
   const firmware_bridge::EmulatorStats& emulator_stats() const { return emulator_->stats(); }
-  std::uint64_t images_rendered() const { return images_.load(std::memory_order_acquire); }
 
  private:
   void run(std::stop_token stop);
-  void render_image(const estimation::TruthSample& truth, common::Stamp stamp);
+  void request_frame(const estimation::TruthSample& truth, common::Stamp stamp);
 
   const OnboardConfig& config_;
   common::SpscRing<common::ImuSample>& imu_ring_;
-  common::SpscRing<common::ImageFrame>& colour_ring_;
-  common::SpscRing<common::ImageFrame>& depth_ring_;
   estimation::SimulationData data_;
-  perception::SyntheticScene scene_;
-  perception::SyntheticDepthCamera camera_;
+  perception::SimWorld world_;
+  std::unique_ptr<SimCameraFeed> camera_;
   Eigen::Isometry3f body_from_optical_;
   int pty_master_ = -1;
   int pty_slave_fd_ = -1;
@@ -65,8 +63,6 @@ class SimRig {
   std::unique_ptr<firmware_bridge::Emulator> emulator_;
   common::Stamp start_;
   std::atomic<bool> finished_{false};
-  std::uint32_t sequence_ = 0;
-  std::atomic<std::uint64_t> images_{0};
   std::jthread thread_;
 };
 

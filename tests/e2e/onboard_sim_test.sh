@@ -13,7 +13,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 # The listener runs as long as the robot (20 s plus start-up) to see its health reports.
-"$listener" --domain "$domain" --seconds 24 --classes 4 --health \
+"$listener" --domain "$domain" --seconds 24 --classes 8 --health \
   --save "$work/received.pcd" >"$work/listener.log" 2>&1 &
 listener_pid=$!
 rm -f build/sim_map.smap

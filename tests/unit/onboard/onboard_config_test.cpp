@@ -42,12 +42,12 @@ std::string error_of(const std::filesystem::path& path) {
 TEST(OnboardConfig, SimulatedRigExample) {
   const auto c = load_onboard_config(kConfigDir / "sim.yaml");
   EXPECT_TRUE(c.rig.simulated);
-  EXPECT_EQ(c.camera.intrinsics.width, 96);
-  EXPECT_EQ(c.camera.intrinsics.height, 64);
-  EXPECT_DOUBLE_EQ(c.camera.driver.fps, 5.0);
+  EXPECT_EQ(c.camera.intrinsics.width, 640);
+  EXPECT_EQ(c.camera.intrinsics.height, 480);
+  EXPECT_DOUBLE_EQ(c.camera.driver.fps, 15.0);
   EXPECT_EQ(c.depth.source, DepthSource::kAligned);
   // Aligned depth takes the colour camera's size unless the file says otherwise.
-  EXPECT_EQ(c.depth.driver.width, 96u);
+  EXPECT_EQ(c.depth.driver.width, 640u);
   EXPECT_EQ(c.depth.driver.format, common::PixelFormat::kZ16);
   EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kPalette);
   EXPECT_FLOAT_EQ(c.segmenter.confidence, 0.9f);
@@ -91,7 +91,7 @@ TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
                 .find("depth.format"),
             std::string::npos);
   EXPECT_NE(error_of(edited_sim("source: aligned", "source: aligned\n  width: 64"))
-                .find("aligned depth of 64x64 does not match the camera's 96x64"),
+                .find("aligned depth of 64x480 does not match the camera's 640x480"),
             std::string::npos);
   EXPECT_NE(error_of(edited_sim("source: aligned", "source: stereo")).find("depth.calibration"),
             std::string::npos);
@@ -108,8 +108,8 @@ TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
 
 TEST(OnboardConfig, SegmenterMustFitTheMap) {
   SegmenterConfig palette;
-  // The built-in Cityscapes mapping feeds map classes up to 3: a 3-class map cannot take it.
-  EXPECT_THROW(make_segmenter(palette, 3), std::invalid_argument);
+  // The default palette feeds the simulated world's map classes 1..7: a 4-class map cannot take it.
+  EXPECT_THROW(make_segmenter(palette, 4), std::invalid_argument);
   SegmenterConfig onnx;
   onnx.kind = SegmenterConfig::Kind::kOnnx;
   onnx.model_card = "/nonexistent/card.yaml";

@@ -194,8 +194,10 @@ TEST_F(PerceptionStageTest, PairsColourAndDepthByStampWithinTheTolerance) {
   ASSERT_TRUE(clouds_.try_pop(cloud));
   EXPECT_EQ(cloud.stamp, at(1.20));
   const auto s = stage->stats();
-  // The 1.10 colour frame is passed over for the newer pair, the 1.15 depth frame unpaired.
-  EXPECT_EQ(s.skipped + s.unpaired, 2u);
+  // The 1.10 colour frame found no depth in time; the 1.15 depth frame was never used.
+  EXPECT_EQ(s.unpaired, 1u);
+  EXPECT_EQ(s.skipped, 0u);
+  EXPECT_EQ(s.depth_unused, 1u);
   EXPECT_EQ(s.clouds, 1u);
 }
 

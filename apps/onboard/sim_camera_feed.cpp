@@ -1,0 +1,142 @@
+#include "sim_camera_feed.hpp"
+
+#include <chrono>
+#include <cstring>
+#include <opencv2/core.hpp>
+
+#include "semap/perception/palette_segmenter.hpp"
+
+namespace semap::onboard {
+
+namespace {
+
+constexpr std::size_t kTruthKept = 64;  // frames: more than the perception stage holds
+
+common::ImageFrame to_frame(const cv::Mat& image, common::PixelFormat format, common::Stamp stamp,
+                            std::uint32_t sequence) {
+  common::ImageFrame f;
+  f.stamp = stamp;
+  f.sequence = sequence;
+  f.format = format;
+  f.width = static_cast<std::uint32_t>(image.cols);
+  f.height = static_cast<std::uint32_t>(image.rows);
+  f.stride = static_cast<std::uint32_t>(image.cols * image.elemSize());
+  f.data.resize(static_cast<std::size_t>(f.stride) * f.height);
+  for (int v = 0; v < image.rows; ++v) {
+    std::memcpy(f.data.data() + static_cast<std::size_t>(v) * f.stride, image.ptr(v), f.stride);
+  }
+  return f;
+}
+
+// Each pixel in its train id's Cityscapes colour (BGR), black where the id has none.
+cv::Mat paint_classes(const cv::Mat& train_ids) {
+  static const auto palette = perception::cityscapes_palette();
+  cv::Mat lut(1, 256, CV_8UC3, cv::Scalar(0, 0, 0));
+  for (std::size_t id = 0; id < palette.size(); ++id) {
+    const auto& rgb = palette[id].color;
+    lut.at<cv::Vec3b>(0, static_cast<int>(id)) = cv::Vec3b(rgb[2], rgb[1], rgb[0]);
+  }
+  cv::Mat three;
+  cv::Mat channels[] = {train_ids, train_ids, train_ids};
+  cv::merge(channels, 3, three);
+  cv::Mat painted;
+  cv::LUT(three, lut, painted);
+  return painted;
+}
+
+}  // namespace
+
+SimCameraFeed::SimCameraFeed(const perception::SimWorld& world,
+                             const perception::SimCameraOptions& camera, SimCameraImage image,
+                             float depth_scale, common::SpscRing<common::ImageFrame>& colour_ring,
+                             common::SpscRing<common::ImageFrame>& depth_ring)
+    : world_(world),
+      camera_(camera),
+      image_(image),
+      depth_scale_(depth_scale),
+      colour_ring_(colour_ring),
+      depth_ring_(depth_ring) {}
+
+SimCameraFeed::~SimCameraFeed() { stop(); }
+
+void SimCameraFeed::start() {
+  thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+}
+
+void SimCameraFeed::stop() {
+  if (thread_.joinable()) {
+    thread_.request_stop();
+    wake_.notify_all();
+    thread_.join();
+  }
+}
+
+void SimCameraFeed::request(const Eigen::Isometry3f& world_from_optical, common::Stamp stamp) {
+  {
+    std::lock_guard lock(mutex_);
+    if (pending_) ++skipped_;
+    pending_ = Request{world_from_optical, stamp};
+  }
+  wake_.notify_one();
+}
+
+std::optional<cv::Mat> SimCameraFeed::true_labels(std::uint32_t sequence) const {
+  std::lock_guard lock(mutex_);
+  for (const auto& [s, labels] : truth_) {
+    if (s == sequence) return labels;
+  }
+  return std::nullopt;
+}
+
+std::uint64_t SimCameraFeed::rendered() const {
+  std::lock_guard lock(mutex_);
+  return rendered_;
+}
+
+std::uint64_t SimCameraFeed::skipped() const {
+  std::lock_guard lock(mutex_);
+  return skipped_;
+}
+
+double SimCameraFeed::render_seconds_mean() const {
+  std::lock_guard lock(mutex_);
+  return rendered_ ? render_seconds_ / static_cast<double>(rendered_) : 0.0;
+}
+
+void SimCameraFeed::run(std::stop_token stop) {
+  std::uint32_t sequence = 0;
+  while (true) {
+    Request request;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, stop, [&] { return pending_.has_value(); });
+      if (stop.stop_requested()) return;
+      request = *pending_;
+      pending_.reset();
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto frame = camera_.render(world_, request.world_from_optical, sequence);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    {
+      // Before the frame is out, so that whoever evaluates it finds its truth.
+      std::lock_guard lock(mutex_);
+      truth_.emplace_back(sequence, frame.labels);
+      if (truth_.size() > kTruthKept) truth_.pop_front();
+      ++rendered_;
+      render_seconds_ += seconds;
+    }
+    publish(frame, request.stamp, sequence);
+    ++sequence;
+  }
+}
+
+void SimCameraFeed::publish(const perception::SimFrame& frame, common::Stamp stamp,
+                            std::uint32_t sequence) {
+  const cv::Mat colour = image_ == SimCameraImage::kRgb ? frame.bgr : paint_classes(frame.labels);
+  colour_ring_.try_push(to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+  depth_ring_.try_push(to_frame(perception::depth_to_z16(frame.depth_m, depth_scale_),
+                                common::PixelFormat::kZ16, stamp, sequence));
+}
+
+}  // namespace semap::onboard

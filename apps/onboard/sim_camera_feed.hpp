@@ -1,0 +1,75 @@
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <opencv2/core/mat.hpp>
+#include <optional>
+#include <thread>
+
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/perception/sim_camera.hpp"
+#include "semap/perception/sim_world.hpp"
+
+namespace semap::onboard {
+
+// What the simulated camera shows the perception stage.
+enum class SimCameraImage {
+  kRgb,      // the rendered scene: textures, shading, noise (for a trained segmenter)
+  kClasses,  // each pixel painted in its class's Cityscapes colour (a perfect segmenter via
+             // the palette)
+};
+
+// The simulated rig's camera on a thread of its own, so that rendering never delays the IMU
+// and GNSS streams: the rig asks for a frame at a pose and stamp, the feed renders it and
+// pushes a BGR24 colour frame and an aligned Z16 depth frame into the rings the camera drivers
+// fill on hardware. It keeps the true classes of recent frames for evaluation.
+class SimCameraFeed {
+ public:
+  SimCameraFeed(const perception::SimWorld& world, const perception::SimCameraOptions& camera,
+                SimCameraImage image, float depth_scale,
+                common::SpscRing<common::ImageFrame>& colour_ring,
+                common::SpscRing<common::ImageFrame>& depth_ring);
+  ~SimCameraFeed();
+  SimCameraFeed(const SimCameraFeed&) = delete;
+  SimCameraFeed& operator=(const SimCameraFeed&) = delete;
+
+  void start();
+  void stop();
+  // A frame at this camera pose (world from optical) and capture stamp. A request the feed
+  // has not started on yet is replaced by the newer one (counted as skipped).
+  void request(const Eigen::Isometry3f& world_from_optical, common::Stamp stamp);
+
+  // True classes (CV_8UC1, Cityscapes train ids) of a recent frame, by its sequence number.
+  std::optional<cv::Mat> true_labels(std::uint32_t sequence) const;
+  std::uint64_t rendered() const;
+  std::uint64_t skipped() const;
+  double render_seconds_mean() const;
+
+ private:
+  struct Request {
+    Eigen::Isometry3f world_from_optical;
+    common::Stamp stamp;
+  };
+  void run(std::stop_token stop);
+  void publish(const perception::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence);
+
+  const perception::SimWorld& world_;
+  perception::SimCamera camera_;
+  SimCameraImage image_;
+  float depth_scale_;
+  common::SpscRing<common::ImageFrame>& colour_ring_;
+  common::SpscRing<common::ImageFrame>& depth_ring_;
+  mutable std::mutex mutex_;
+  std::condition_variable_any wake_;
+  std::optional<Request> pending_;
+  std::deque<std::pair<std::uint32_t, cv::Mat>> truth_;  // the last few frames' classes
+  std::uint64_t rendered_ = 0;
+  std::uint64_t skipped_ = 0;
+  double render_seconds_ = 0.0;
+  std::jthread thread_;
+};
+
+}  // namespace semap::onboard

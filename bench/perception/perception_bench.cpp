@@ -1,0 +1,288 @@
+// Prints the perception figures of issue 14 for 640x480 frames on this machine: per-stage
+// medians and 90th percentiles (decode, segment, depth -> points, posing, map insert), then a
+// steady-state run of the real PerceptionStage and MappingStage on their own threads, fed at
+// 15 Hz with YUYV colour and aligned Z16 depth while a pose thread drives a circle.
+// The last line is parsed by scripts:
+//   steady state: F frames/s mapped, latency p50 A ms p99 B ms, cpu C cores
+#include <sys/resource.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench_inputs.hpp"
+#include "mapping_stage.hpp"
+#include "perception_stage.hpp"
+#include "segmenter_factory.hpp"
+#include "semap/drivers/frame_convert.hpp"
+#include "semap/drivers/jpeg_decoder.hpp"
+#include "semap/perception/depth_cloud.hpp"
+#include "semap/perception/onnx_segmenter.hpp"
+#include "semap/perception/palette_segmenter.hpp"
+#include "shared_pose_history.hpp"
+
+namespace {
+
+namespace bench = semap::bench;
+namespace common = semap::common;
+namespace onboard = semap::onboard;
+namespace perception = semap::perception;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kWidth = 640;
+constexpr int kHeight = 480;
+constexpr double kCameraHz = 15.0;
+constexpr double kPoseHz = 200.0;
+constexpr int kMapClasses = 4;
+
+struct Options {
+  double seconds = 20.0;
+  int frames = 30;
+  int threads = 2;     // the map's TBB threads
+  int cv_threads = 1;  // OpenCV's (the model card's threads)
+  int stride = 2;      // every 2nd pixel: finer than the map's 0.2 m at 640x480 still
+  std::string infer = "320x240";
+};
+
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  const auto s = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6;
+  };
+  return s(u.ru_utime) + s(u.ru_stime);
+}
+
+void row(const std::string& what, const bench::Spread& s) {
+  std::printf("  %-60s p50 %7.2f ms  p90 %7.2f ms\n", what.c_str(), s.p50, s.p90);
+}
+
+// A folder for the model card and network, removed at exit.
+struct TempDir {
+  std::filesystem::path path = std::filesystem::temp_directory_path() /
+                               ("semap_perception_bench_" + std::to_string(::getpid()));
+  TempDir() { std::filesystem::create_directories(path); }
+  ~TempDir() { std::filesystem::remove_all(path); }
+};
+
+common::LabeledCloud to_world(common::LabeledCloud cloud, const semap::estimation::StampedPose& p) {
+  Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
+  world_from_body.linear() = p.orientation.toRotationMatrix().cast<float>();
+  world_from_body.translation() = p.position.cast<float>();
+  for (auto& q : cloud.points) q = world_from_body * q;
+  cloud.origin = world_from_body * cloud.origin;
+  return cloud;
+}
+
+void per_stage(const Options& o, const onboard::OnboardConfig& config,
+               const bench::SceneImages& scene, const bench::BenchModel& model) {
+  const int n = o.frames;
+  std::printf("per frame (%d frames each):\n", n);
+  semap::drivers::JpegDecoder jpeg;
+  cv::Mat image;
+  row("decode YUYV -> BGR (drivers::to_mat)",
+      bench::time_ms(n, [&](int) { image = semap::drivers::to_mat(scene.yuyv, jpeg); }));
+  common::ImageFrame mjpeg = scene.yuyv;
+  mjpeg.format = common::PixelFormat::kMjpeg;
+  cv::imencode(".jpg", scene.camera_bgr, mjpeg.data, {cv::IMWRITE_JPEG_QUALITY, 90});
+  const std::string jpeg_what =
+      "decode MJPEG -> BGR (q90, " + std::to_string(mjpeg.data.size() / 1024) + " KiB)";
+  row(jpeg_what, bench::time_ms(n, [&](int) { image = semap::drivers::to_mat(mjpeg, jpeg); }));
+
+  perception::OnnxSegmenter onnx(perception::load_model_card(model.card));
+  const cv::Mat bgr = semap::drivers::to_mat(scene.yuyv, jpeg);
+  perception::Segmentation seg;
+  char what[160];
+  std::snprintf(what, sizeof what, "segment ONNX at %s (%.2f GFLOP, %d -> %d classes)",
+                o.infer.c_str(), model.gflops, model.classes, kMapClasses);
+  row(what, bench::time_ms(n, [&](int) { seg = onnx.segment(bgr); }));
+  perception::PaletteSegmenter palette(perception::cityscapes_palette(), kMapClasses);
+  perception::Segmentation palette_seg;
+  row("segment palette (Cityscapes colours)",
+      bench::time_ms(n, [&](int) { palette_seg = palette.segment(scene.label_bgr); }));
+
+  const cv::Mat z16 = semap::drivers::to_mat(scene.z16, jpeg);
+  const Eigen::Isometry3f body_from_optical = config.camera.body_from_optical();
+  common::LabeledCloud clouds[2];
+  for (const int stride : {1, 2}) {
+    perception::PointOptions points = config.depth.points;
+    points.stride = stride;
+    perception::DropCounts drops;
+    common::LabeledCloud& cloud = clouds[stride - 1];
+    const auto s = bench::time_ms(n, [&](int) {
+      cloud =
+          perception::cloud_from_depth(perception::depth_metres(z16, 0.001f), seg,
+                                       config.camera.intrinsics, body_from_optical, points, drops);
+    });
+    row("depth -> points, stride " + std::to_string(stride) + " (" + std::to_string(cloud.size()) +
+            " points)",
+        s);
+  }
+
+  onboard::SharedPoseHistory poses(4096);
+  std::vector<semap::estimation::StampedPose> trajectory;
+  for (int i = 0; i <= 2000; ++i) {
+    trajectory.push_back(bench::circle_pose(i / kPoseHz, common::Stamp::from_seconds(i / kPoseHz)));
+  }
+  poses.append(trajectory);
+  common::LabeledCloud world;
+  row("posing: SharedPoseHistory::at + to world (stride 1)", bench::time_ms(n, [&](int i) {
+        const auto lookup = poses.at(common::Stamp::from_seconds((i + 0.37) / kCameraHz));
+        world = to_world(clouds[0], lookup.pose);
+      }));
+
+  tbb::task_arena arena(o.threads);
+  for (const int stride : {1, 2}) {
+    semap::mapping::SemanticMap map(config.map);
+    const auto s = bench::time_ms(n, [&](int i) {
+      const double t = i / kCameraHz;
+      common::LabeledCloud cloud = to_world(clouds[stride - 1], bench::circle_pose(t, {}));
+      arena.execute([&] { map.insert(cloud, cloud.origin); });
+    });
+    const auto stats = map.stats();
+    row("map insert S-BKI, stride " + std::to_string(stride) + ", " + std::to_string(o.threads) +
+            " threads (" + std::to_string(stats.blocks) + " blocks)",
+        s);
+  }
+}
+
+struct SteadyState {
+  double mapped_hz = 0, cpu_cores = 0;
+  onboard::LatencyPercentiles latency;
+};
+
+SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
+                         const bench::SceneImages& scene, const bench::BenchModel& model) {
+  using common::OverflowPolicy;
+  common::SpscRing<common::ImageFrame> colour_ring(config.camera.ring, OverflowPolicy::kDropOldest);
+  common::SpscRing<common::ImageFrame> depth_ring(config.depth.ring, OverflowPolicy::kDropOldest);
+  common::SpscRing<common::LabeledCloud> cloud_ring(config.depth.ring, OverflowPolicy::kDropOldest);
+  onboard::SharedPoseHistory poses(config.estimator.history);
+  onboard::SegmenterConfig seg;
+  seg.kind = onboard::SegmenterConfig::Kind::kOnnx;
+  seg.model_card = model.card;
+  onboard::PerceptionStage perception(config.camera, config.depth,
+                                      onboard::make_segmenter(seg, config.map.num_classes),
+                                      colour_ring, &depth_ring, poses, cloud_ring);
+  onboard::MappingStage mapping(config, cloud_ring, nullptr);
+
+  // The estimation stage's part: filter poses at 200 Hz, stamped now.
+  const common::Stamp t0 = common::Stamp::now();
+  std::jthread pose_thread([&](std::stop_token stop) {
+    auto next = Clock::now();
+    while (!stop.stop_requested()) {
+      const common::Stamp now = common::Stamp::now();
+      const auto pose = bench::circle_pose(common::seconds_between(now, t0), now);
+      poses.append({&pose, 1});
+      next += std::chrono::microseconds(static_cast<int>(1e6 / kPoseHz));
+      std::this_thread::sleep_until(next);
+    }
+  });
+  mapping.start();
+  perception.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+
+  const double cpu0 = cpu_seconds();
+  const auto start = Clock::now();
+  const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / kCameraHz));
+  const auto frames = static_cast<std::uint32_t>(o.seconds * kCameraHz);
+  for (std::uint32_t i = 0; i < frames; ++i) {
+    std::this_thread::sleep_until(start + i * period);
+    common::ImageFrame colour = scene.yuyv, depth = scene.z16;
+    colour.stamp = depth.stamp = common::Stamp::now();
+    colour.sequence = depth.sequence = i;
+    colour_ring.try_push(std::move(colour));
+    depth_ring.try_push(std::move(depth));
+  }
+  std::this_thread::sleep_until(start + frames * period);
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  const double cpu = cpu_seconds() - cpu0;
+  const auto m = mapping.stats();
+  perception.stop();
+  mapping.stop();
+  pose_thread.request_stop();
+  const auto p = perception.stats();
+
+  const auto drops = [](const auto& ring) { return ring.counters().drops(); };
+  const std::uint64_t ring_drops = drops(colour_ring) + drops(cloud_ring);
+  std::printf("steady state over %.1f s (%u frames pushed at %.0f Hz, stride %d):\n", wall, frames,
+              kCameraHz, config.depth.points.stride);
+  std::printf(
+      "  perception: %lu frames, %lu clouds, segment mean %.1f ms max %.1f ms, %.0f "
+      "points/cloud, frame -> posed cloud p50 %.1f ms p99 %.1f ms\n",
+      p.frames, p.clouds,
+      p.frames ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
+      1e3 * p.segment_seconds_max,
+      p.clouds ? static_cast<double>(p.points) / static_cast<double>(p.clouds) : 0.0,
+      perception.latency().percentiles().p50_ms, perception.latency().percentiles().p99_ms);
+  std::printf("  mapping: %lu scans, insert mean %.1f ms max %.1f ms, map %zu blocks %zu cells\n",
+              m.scans, m.scans ? 1e3 * m.insert_seconds_total / static_cast<double>(m.scans) : 0.0,
+              1e3 * m.insert_seconds_max, m.map.blocks, m.map.cells);
+  std::printf("  drops: %lu (ring %lu, skipped %lu, unpaired %lu, without pose %lu, bad %lu)\n",
+              ring_drops + p.skipped + p.unpaired + p.without_pose + p.bad_frames, ring_drops,
+              p.skipped, p.unpaired, p.without_pose, p.bad_frames);
+  return {static_cast<double>(m.scans) / wall, cpu / wall, mapping.latency().percentiles()};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"perception_bench: camera -> segmentation -> points -> S-BKI map, 640x480"};
+  app.add_option("--seconds", o.seconds, "steady-state run length")->check(CLI::PositiveNumber);
+  app.add_option("--frames", o.frames, "frames per per-stage figure")->check(CLI::Range(1, 100000));
+  app.add_option("--threads", o.threads, "TBB threads of the map insert")->check(CLI::Range(1, 64));
+  app.add_option("--cv-threads", o.cv_threads, "OpenCV threads (model card `threads`)")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--stride", o.stride, "pixel stride of depth -> points in the steady state")
+      ->check(CLI::Range(1, 16));
+  app.add_option("--infer", o.infer, "network input size WxH");
+  CLI11_PARSE(app, argc, argv);
+  int infer_w = 0, infer_h = 0;
+  if (std::sscanf(o.infer.c_str(), "%dx%d", &infer_w, &infer_h) != 2 || infer_w < 8 ||
+      infer_h < 8) {
+    std::fprintf(stderr, "--infer: expected WxH, got '%s'\n", o.infer.c_str());
+    return 2;
+  }
+
+  onboard::OnboardConfig config;
+  config.camera.driver.width = kWidth;
+  config.camera.driver.height = kHeight;
+  config.camera.driver.fps = kCameraHz;
+  config.camera.intrinsics =
+      perception::PinholeIntrinsics::from_fov(kWidth, kHeight, std::numbers::pi_v<float> / 2);
+  config.depth.points.stride = o.stride;
+  config.depth.points.max_range = 20.0f;
+  config.map.resolution = 0.2f;  // config/sim.yaml's map
+  config.map.block_depth = 3;
+  config.map.num_classes = kMapClasses;
+  config.map.ell = 0.5f;
+  config.map.free_res = 1.0f;
+  config.map.ds_res = 0.2f;
+  config.map.max_range = 20.0f;
+  config.map_threads = o.threads;
+
+  const TempDir dir;
+  const auto scene = bench::render_scene(config.camera, config.depth.depth_scale);
+  const auto model =
+      bench::write_bench_model(dir.path, infer_w, infer_h, kMapClasses, o.cv_threads);
+  double load[3] = {};
+  getloadavg(load, 3);
+  std::printf("perception_bench: %dx%d, map threads %d, OpenCV threads %d, load %.2f %.2f %.2f\n",
+              kWidth, kHeight, o.threads, o.cv_threads, load[0], load[1], load[2]);
+  per_stage(o, config, scene, model);
+  const SteadyState s = steady_state(o, config, scene, model);
+  std::printf(
+      "steady state: %.1f frames/s mapped, latency p50 %.0f ms p99 %.0f ms, cpu %.2f cores\n",
+      s.mapped_hz, s.latency.p50_ms, s.latency.p99_ms, s.cpu_cores);
+  return 0;
+}
