@@ -118,10 +118,12 @@ SimFrame SimCamera::render(const SimWorld& world, const Eigen::Isometry3f& world
       // The optical ray (a, b, 1) has length len; t along the unit ray is depth z = t / len.
       const float len = std::sqrt(a * a + b * b + 1.0f);
       const Eigen::Vector3f d = (row + a * r.col(0)) / len;
-      std::optional<SimHit> hit = world.cast_ground(origin, d, options_.visual_range);
-      const auto solid =
-          bins.cast(world.solids(), u, v, origin, d, hit ? hit->t : options_.visual_range);
-      if (solid.solid >= 0) hit = world.solid_hit(solid.solid, origin, d, solid.t);
+      // Solids first: the ground behind one then costs no road lookup.
+      const auto solid = bins.cast(world.solids(), u, v, origin, d, options_.visual_range);
+      std::optional<SimHit> hit = world.cast_ground(origin, d, solid.t);
+      if (solid.solid >= 0 && !(hit && hit->t < solid.t)) {
+        hit = world.solid_hit(solid.solid, origin, d, solid.t);
+      }
       Eigen::Vector3f colour;
       if (hit) {
         colour = radiance(world, *hit, origin + hit->t * d, sun, options_.fog_distance);

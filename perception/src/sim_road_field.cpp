@@ -83,9 +83,7 @@ SimRoadField::Sample SimRoadField::at(float x, float y) const {
   }
   const int ix = static_cast<int>(fx);
   const int iy = static_cast<int>(fy);
-  const std::array<std::int32_t, 4> cells = {nearest_.get(ix, iy), nearest_.get(ix + 1, iy),
-                                             nearest_.get(ix, iy + 1),
-                                             nearest_.get(ix + 1, iy + 1)};
+  const std::array<std::int32_t, 4> cells = nearest_.quad(ix, iy);
   const Eigen::Vector2f p(x, y);
   if (cells[0] >= 0 && cells[0] == cells[1] && cells[0] == cells[2] && cells[0] == cells[3]) {
     const Sample s = measure(segments_[static_cast<std::size_t>(cells[0])], p);

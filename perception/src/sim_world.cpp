@@ -55,6 +55,8 @@ std::optional<SimHit> SimWorld::cast_ground(const Eigen::Vector3f& o, const Eige
     return t <= max_range ? std::optional<SimHit>(SimHit{t, n, -1, train_id, road}) : std::nullopt;
   };
   const float t0 = o.z() / -d.z();
+  const float t1 = std::max(0.0f, (o.z() - kerb) / -d.z());
+  if (t1 > max_range) return std::nullopt;  // (t1 <= t0) without a lookup
   const Eigen::Vector3f p0 = o + t0 * d;
   const auto at0 = road_.at(p0.x(), p0.y());
   if (o.z() <= kerb) {
@@ -63,12 +65,10 @@ std::optional<SimHit> SimWorld::cast_ground(const Eigen::Vector3f& o, const Eige
   }
   // p1 is `shift` away from p0 in plan and the distance is 1-Lipschitz: p0 well inside the
   // road settles it without a second query.
-  const float t1 = (o.z() - kerb) / -d.z();
   const float shift = (t0 - t1) * std::sqrt(d.x() * d.x() + d.y() * d.y());
   if (at0.distance < edge - shift) {
     return hit(t0, Eigen::Vector3f::UnitZ(), sim_train_id::kRoad, at0);
   }
-  if (t1 > max_range) return std::nullopt;
   const Eigen::Vector3f p1 = o + t1 * d;
   const auto at1 = road_.at(p1.x(), p1.y());
   if (at1.distance >= edge) {

@@ -15,7 +15,8 @@ namespace semap::perception {
 // each cell. A ray walks it cell by cell (2D DDA, Amanatides & Woo), testing the solids of
 // each cell, and stops at the first cell whose nearest hit lies inside it: nothing in a
 // later cell can be nearer. Runs of empty cells are jumped over using each cell's Chebyshev
-// distance to the nearest occupied cell, and cells the ray passes above are not tested.
+// distance to the nearest occupied cell, cells the ray passes above are not tested, and the
+// last few solids tested are not tested again in the next cells.
 class SimSolidGrid {
  public:
   struct Hit {
@@ -23,7 +24,6 @@ class SimSolidGrid {
     std::int32_t solid;  // -1: nothing before t_end
   };
 
-  SimSolidGrid() = default;
   SimSolidGrid(std::span<const SimSolid> solids, const Eigen::AlignedBox2f& extent, float cell);
 
   // Nearest entry of o + t d (d unit) into one of `solids` (those the grid was built from)
@@ -46,8 +46,6 @@ class SimSolidGrid {
       }
     }
   }
-
-  float top() const { return top_; }  // highest solid top
 
  private:
   // Cells are clamped to the grid; the conversion truncates, which is floor for v >= origin.
