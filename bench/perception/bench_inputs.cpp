@@ -10,8 +10,9 @@
 #include <sstream>
 #include <string>
 
-#include "semap/perception/synthetic_depth_camera.hpp"
-#include "semap/perception/synthetic_scene.hpp"
+#include "semap/perception/palette_segmenter.hpp"
+#include "semap/perception/sim_camera.hpp"
+#include "semap/perception/sim_world.hpp"
 // GCC 12 at -O3 reports a false -Wrestrict in the writer's string concatenation (GCC PR 105329).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wrestrict"
@@ -21,14 +22,6 @@
 namespace semap::bench {
 
 namespace {
-
-// BGR of the scene's classes, the Cityscapes colours of sky (no return), road, building, pole.
-constexpr std::array<std::array<std::uint8_t, 3>, 4> kColours = {{
-    {180, 130, 70},
-    {128, 64, 128},
-    {70, 70, 70},
-    {153, 153, 153},
-}};
 
 // YUYV 4:2:2: Y0 U Y1 V per pixel pair, chroma averaged over the pair.
 common::ImageFrame to_yuyv(const cv::Mat& bgr) {
@@ -56,37 +49,34 @@ common::ImageFrame to_yuyv(const cv::Mat& bgr) {
 }  // namespace
 
 SceneImages render_scene(const onboard::CameraConfig& camera, float depth_scale) {
-  perception::SyntheticScene scene;  // body frame: x forward, y left, ground at z = 0
-  scene.add_box({14.0f, -8.0f, 0.0f}, {14.5f, 8.0f, 5.0f});  // facade ahead
-  scene.add_box({3.0f, 5.0f, 0.0f}, {14.0f, 5.4f, 4.0f});    // wall on the left
-  scene.add_box({6.0f, -6.0f, 0.0f}, {10.0f, -4.5f, 6.0f});  // building on the right
-  scene.add_cylinder({5.0f, 2.5f}, 0.15f, 4.0f);
-  scene.add_cylinder({9.0f, -3.0f}, 0.15f, 5.0f);
-  const auto& k = camera.intrinsics;
-  const perception::SyntheticDepthCamera rgbd(k, 30.0f);
-  const auto image = rgbd.render(scene, camera.body_from_optical(), common::Stamp{});
+  // A street 60 m long ahead of the camera, in the simulated world the demo drives through.
+  std::vector<Eigen::Vector3d> path;
+  for (int i = 0; i <= 60; ++i) path.emplace_back(i, 0.0, 0.0);
+  perception::SimWorldOptions world_options;
+  world_options.seed = 11;
+  const perception::SimWorld world(path, world_options);
+  perception::SimCameraOptions options;
+  options.intrinsics = camera.intrinsics;
+  const auto frame = perception::SimCamera(options).render(world, camera.body_from_optical(), 0);
 
   SceneImages out;
-  out.label_bgr.create(k.height, k.width, CV_8UC3);
-  out.z16 = common::ImageFrame{};
-  out.z16.format = common::PixelFormat::kZ16;
-  out.z16.width = static_cast<std::uint32_t>(k.width);
-  out.z16.height = static_cast<std::uint32_t>(k.height);
-  out.z16.stride = 2 * out.z16.width;
-  out.z16.data.assign(static_cast<std::size_t>(out.z16.stride) * out.z16.height, 0);
-  for (std::size_t i = 0; i < image.depth.size(); ++i) {
-    const float z = image.depth[i];
-    const auto& c = kColours[z > 0.0f ? std::min<std::size_t>(image.labels[i], 3) : 0];
-    std::memcpy(out.label_bgr.data + 3 * i, c.data(), 3);
-    const auto units = static_cast<std::uint16_t>(std::min(65535.0f, std::round(z / depth_scale)));
-    std::memcpy(out.z16.data.data() + 2 * i, &units, sizeof units);
+  out.camera_bgr = frame.bgr;
+  // The true classes in their Cityscapes colours, what PaletteSegmenter reads.
+  const auto palette = perception::cityscapes_palette();
+  out.label_bgr.create(frame.labels.size(), CV_8UC3);
+  for (int v = 0; v < frame.labels.rows; ++v) {
+    for (int u = 0; u < frame.labels.cols; ++u) {
+      const auto id = frame.labels.at<std::uint8_t>(v, u);
+      const cv::Vec3b rgb = id < palette.size() ? palette[id].color : cv::Vec3b(0, 0, 0);
+      out.label_bgr.at<cv::Vec3b>(v, u) = cv::Vec3b(rgb[2], rgb[1], rgb[0]);
+    }
   }
-  // Sensor noise, so MJPEG and the network see texture rather than flat colours.
-  cv::Mat noise(out.label_bgr.size(), CV_16SC3);
-  cv::randn(noise, 0.0, 6.0);
-  out.label_bgr.convertTo(out.camera_bgr, CV_16SC3);
-  out.camera_bgr += noise;
-  out.camera_bgr.convertTo(out.camera_bgr, CV_8UC3);
+  const cv::Mat z16 = perception::depth_to_z16(frame.depth_m, depth_scale);
+  out.z16.format = common::PixelFormat::kZ16;
+  out.z16.width = static_cast<std::uint32_t>(z16.cols);
+  out.z16.height = static_cast<std::uint32_t>(z16.rows);
+  out.z16.stride = 2 * out.z16.width;
+  out.z16.data.assign(z16.datastart, z16.dataend);
   out.yuyv = to_yuyv(out.camera_bgr);
   return out;
 }

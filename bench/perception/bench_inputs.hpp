@@ -23,8 +23,8 @@ struct SceneImages {
   common::ImageFrame z16;   // aligned depth in depth_scale units, 0 = no return
 };
 
-// Ground, three building walls and two poles in front of the camera, sky above; rendered
-// at the camera's intrinsics and mount, depth up to 30 m.
+// A street of the simulated world (SimWorld, seed 11) seen by the simulated camera at the
+// camera's intrinsics and mount.
 SceneImages render_scene(const onboard::CameraConfig& camera, float depth_scale);
 
 struct BenchModel {

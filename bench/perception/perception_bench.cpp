@@ -28,6 +28,7 @@
 #include "semap/perception/depth_cloud.hpp"
 #include "semap/perception/onnx_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
+#include "semap/perception/sim_classes.hpp"
 #include "shared_pose_history.hpp"
 
 namespace {
@@ -42,7 +43,7 @@ constexpr int kWidth = 640;
 constexpr int kHeight = 480;
 constexpr double kCameraHz = 15.0;
 constexpr double kPoseHz = 200.0;
-constexpr int kMapClasses = 4;
+constexpr int kMapClasses = perception::kSimMapClasses;
 
 struct Options {
   double seconds = 20.0;
@@ -51,6 +52,7 @@ struct Options {
   int cv_threads = 1;  // OpenCV's (the model card's threads)
   int stride = 2;      // every 2nd pixel: finer than the map's 0.2 m at 640x480 still
   std::string infer = "320x240";
+  std::filesystem::path model_card;  // a trained network instead of the synthetic one
 };
 
 double cpu_seconds() {
@@ -102,10 +104,16 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
   const cv::Mat bgr = semap::drivers::to_mat(scene.yuyv, jpeg);
   perception::Segmentation seg;
   char what[160];
-  std::snprintf(what, sizeof what, "segment ONNX at %s (%.2f GFLOP, %d -> %d classes)",
-                o.infer.c_str(), model.gflops, model.classes, kMapClasses);
+  if (model.gflops > 0.0) {
+    std::snprintf(what, sizeof what, "segment ONNX at %s (%.2f GFLOP, %d -> %d classes)",
+                  o.infer.c_str(), model.gflops, model.classes, kMapClasses);
+  } else {
+    std::snprintf(what, sizeof what, "segment ONNX at %s (%s, %d -> %d classes)", o.infer.c_str(),
+                  o.model_card.filename().c_str(), model.classes, kMapClasses);
+  }
   row(what, bench::time_ms(n, [&](int) { seg = onnx.segment(bgr); }));
-  perception::PaletteSegmenter palette(perception::cityscapes_palette(), kMapClasses);
+  perception::PaletteSegmenter palette(
+      perception::cityscapes_palette(perception::sim_cityscapes_mapping()), kMapClasses);
   perception::Segmentation palette_seg;
   row("segment palette (Cityscapes colours)",
       bench::time_ms(n, [&](int) { palette_seg = palette.segment(scene.label_bgr); }));
@@ -245,7 +253,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_option("--stride", o.stride, "pixel stride of depth -> points in the steady state")
       ->check(CLI::Range(1, 16));
-  app.add_option("--infer", o.infer, "network input size WxH");
+  app.add_option("--infer", o.infer, "network input size WxH of the synthetic network");
+  app.add_option("--model-card", o.model_card, "run this network (e.g. models/semap-seg.yaml)")
+      ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
   int infer_w = 0, infer_h = 0;
   if (std::sscanf(o.infer.c_str(), "%dx%d", &infer_w, &infer_h) != 2 || infer_w < 8 ||
@@ -273,8 +283,15 @@ int main(int argc, char** argv) {
 
   const TempDir dir;
   const auto scene = bench::render_scene(config.camera, config.depth.depth_scale);
-  const auto model =
-      bench::write_bench_model(dir.path, infer_w, infer_h, kMapClasses, o.cv_threads);
+  bench::BenchModel model;
+  if (o.model_card.empty()) {
+    model = bench::write_bench_model(dir.path, infer_w, infer_h, kMapClasses, o.cv_threads);
+  } else {
+    const auto card = perception::load_model_card(o.model_card);
+    model.card = o.model_card;
+    model.classes = static_cast<int>(card.classes.size());
+    o.infer = std::to_string(card.input_width) + "x" + std::to_string(card.input_height);
+  }
   double load[3] = {};
   getloadavg(load, 3);
   std::printf("perception_bench: %dx%d, map threads %d, OpenCV threads %d, load %.2f %.2f %.2f\n",

@@ -2,10 +2,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <cstdint>
-#include <vector>
-
-#include "semap/common/messages.hpp"
 
 namespace semap::perception {
 
@@ -23,14 +19,6 @@ struct PinholeIntrinsics {
   Eigen::Vector3f ray(float u, float v) const {
     return Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.0f);
   }
-};
-
-// A depth image (z-depth in metres, 0 = no return) with a per-pixel class from a segmenter,
-// both row-major, width * height.
-struct LabeledDepthImage {
-  common::Stamp stamp;
-  std::vector<float> depth;
-  std::vector<std::uint16_t> labels;
 };
 
 // Rotation from the optical frame to a FLU body frame (optical z forward = body x).
