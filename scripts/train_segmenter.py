@@ -187,8 +187,8 @@ def write_card(args, info, names, mean, std, width, height, n_train, n_val, seco
         f"#   {parameters} parameters, ONNX opset 11.",
         f"# Training set: {n_train} frames of the simulated camera ({info['train_description']}).",
         f"# Validation set: {n_val} frames ({info['val_description']}), never seen in training.",
-        f"# Training: {args.epochs} epochs, Adam, cosine schedule, batch {args.batch}, torch seed",
-        f"#   {args.seed}, CPU with {args.threads} threads, {seconds:.0f} s.",
+        f"# Training: {args.epochs} epochs, Adam, cosine schedule, batch {args.batch},",
+        f"#   torch seed {args.seed}, CPU with {args.threads} threads, {seconds:.0f} s.",
         "# Validation pixel IoU per class:",
     ]
     for name, iou in zip(names, ious):

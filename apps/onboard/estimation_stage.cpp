@@ -3,7 +3,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <numbers>
 #include <vector>
+
+#include "semap/common/logging.hpp"
 
 namespace semap::onboard {
 
@@ -39,6 +43,7 @@ EstimationStageStats EstimationStage::stats() const {
 void EstimationStage::run(std::stop_token stop) {
   while (!stop.stop_requested()) {
     const bool busy = drain_sensors();
+    check_heading();
     publish_pose();
     share_stats();
     if (!busy) std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -63,7 +68,7 @@ bool EstimationStage::drain_sensors() {
       last_imu_ = imu_batch[i];
       estimator_.add_imu(imu_batch[i++]);
       ++local_.imu_samples;
-      if (estimator_.initialised()) {
+      if (local_.heading_settled) {
         if (auto pose = estimator_.pose_at(estimator_.filter_time())) new_poses_.push_back(*pose);
       }
     }
@@ -79,6 +84,22 @@ bool EstimationStage::drain_sensors() {
     new_poses_.clear();
   }
   return n_imu + n_gnss > 0;
+}
+
+// The yaw variance needs the covariance, which the InEKF forms on demand: ten checks per
+// second of filter time until the heading has settled once.
+void EstimationStage::check_heading() {
+  if (local_.heading_settled || !estimator_.initialised()) return;
+  const common::Stamp now = estimator_.filter_time();
+  if (now < next_heading_check_) return;
+  next_heading_check_ = now + 0.1;
+  const double yaw_sigma_deg =
+      std::sqrt(estimator_.filter().rotation_covariance_world()(2, 2)) * 180.0 / std::numbers::pi;
+  if (yaw_sigma_deg > config_.map_start_heading_sigma_deg) return;
+  local_.heading_settled = now;
+  common::logger("estimation")
+      ->info("heading settled (sigma {:.2f} deg): camera frames are mapped from now on",
+             yaw_sigma_deg);
 }
 
 void EstimationStage::publish_pose() {

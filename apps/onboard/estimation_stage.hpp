@@ -19,6 +19,8 @@ struct EstimationStageStats {
   std::uint64_t imu_samples = 0;
   std::uint64_t gnss_fixes = 0;
   std::uint64_t poses_published = 0;
+  // When the heading first met map.start_heading_sigma_deg; poses go to perception from then.
+  std::optional<common::Stamp> heading_settled;
   bool initialised = false;
   estimation::EstimatorCounters estimator;
   std::optional<estimation::StampedPose> latest;
@@ -35,7 +37,8 @@ struct PoseOutput {
 };
 
 // Owns the Estimator on its own thread: drains the IMU and GNSS rings in stamp order and
-// shares the filter's poses with the perception stage, which poses frames at their stamps.
+// shares the filter's poses with the perception stage, which poses frames at their stamps,
+// once the filter's heading has settled (map.start_heading_sigma_deg).
 class EstimationStage {
  public:
   using PoseSink = std::function<void(const PoseOutput&)>;
@@ -57,6 +60,7 @@ class EstimationStage {
   void run(std::stop_token stop);
   bool drain_sensors();
   void publish_pose();
+  void check_heading();
   void share_stats();
 
   const OnboardConfig& config_;
@@ -66,6 +70,7 @@ class EstimationStage {
   PoseSink pose_sink_;
   estimation::Estimator estimator_;
   std::vector<estimation::StampedPose> new_poses_;
+  common::Stamp next_heading_check_;
   common::ImuSample last_imu_;
   common::Stamp next_pose_publish_;
   EstimationStageStats local_;

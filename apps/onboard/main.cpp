@@ -1,7 +1,8 @@
 // semap-onboard: the robot's main job. Drivers -> rings -> estimation stage (InEKF) and
 // perception stage (segmentation, labelled points posed at their stamps) -> mapping stage
 // (S-BKI) -> DDS. With rig.kind: sim it runs on the built-in
-// simulated sensor rig and reports its own accuracy against the simulated truth.
+// simulated sensor rig and reports its own accuracy against the simulated truth (--report DIR:
+// images, the map and summary.json, see SimReport).
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
@@ -24,10 +25,10 @@
 #include "semap/drivers/camera_driver.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/drivers/gnss_driver.hpp"
-#include "semap/estimation/geodesy.hpp"
 #include "semap/mapping/semantic_layers.hpp"
 #include "semap/mapping/smap_io.hpp"
 #include "shared_pose_history.hpp"
+#include "sim_report.hpp"
 #include "sim_rig.hpp"
 
 namespace {
@@ -42,16 +43,11 @@ using semap::common::SpscRing;
 class LiveAccuracy {
  public:
   void sample(const semap::onboard::SimRig& rig, const semap::onboard::EstimationStageStats& s) {
-    if (!s.initialised || !s.latest || !s.anchor) return;
-    if (!first_) first_ = s.latest->stamp;
-    if (semap::common::seconds_between(s.latest->stamp, *first_) < 10.0) return;  // settling
-    const auto truth = rig.truth_at(s.latest->stamp);
-    if (!truth) return;
-    const semap::estimation::LocalEnu sim_frame(rig.data().origin);
-    // The filter's frame is anchored at its first good fix (and shifted by re-anchoring).
-    const Eigen::Vector3d anchor = sim_frame.to_enu(*s.anchor);
-    const Eigen::Vector3d estimate = s.latest->position + anchor - s.anchor_offset;
-    const double e2 = (estimate - truth->state.position).squaredNorm();
+    const auto pose = semap::onboard::pose_vs_truth(rig, s);
+    if (!pose) return;
+    if (!first_) first_ = pose->stamp;
+    if (semap::common::seconds_between(pose->stamp, *first_) < 10.0) return;  // settling
+    const double e2 = (pose->estimate - pose->truth).squaredNorm();
     sum_sq_ += e2;
     max_ = std::max(max_, std::sqrt(e2));
     ++count_;
@@ -116,7 +112,37 @@ std::vector<semap::onboard::StageFigures> stage_figures(
   return figures;
 }
 
-int run(const semap::onboard::OnboardConfig& config) {
+// Rates over the last interval, ring depths and drops: the progress line every few seconds.
+class Progress {
+ public:
+  std::string line(double t, const semap::onboard::EstimationStageStats& est,
+                   const semap::onboard::PerceptionStageStats& perception,
+                   const semap::onboard::MappingStageStats& map, const Rings& r) {
+    const double dt = t - last_t_;
+    const auto rate = [&](std::uint64_t now, std::uint64_t& before) {
+      const double hz = dt > 0 ? static_cast<double>(now - before) / dt : 0.0;
+      before = now;
+      return hz;
+    };
+    const double imu = rate(est.imu_samples, imu_), gnss = rate(est.gnss_fixes, gnss_),
+                 frames = rate(perception.frames, frames_),
+                 clouds = rate(perception.clouds, clouds_), scans = rate(map.scans, scans_);
+    last_t_ = t;
+    return fmt::format(
+        "t={:.0f}s init={} | Hz imu {:.0f} gnss {:.1f} frames {:.1f} clouds {:.1f} scans {:.1f} | "
+        "blocks {} | rings imu/gnss/colour/depth/clouds: queued {}/{}/{}/{}/{} dropped "
+        "{}/{}/{}/{}/{}",
+        t, est.initialised ? "yes" : "no", imu, gnss, frames, clouds, scans, map.map.blocks,
+        r.imu.size(), r.gnss.size(), r.colour.size(), r.depth.size(), r.clouds.size(), drops(r.imu),
+        drops(r.gnss), drops(r.colour), drops(r.depth), drops(r.clouds));
+  }
+
+ private:
+  double last_t_ = 0.0;
+  std::uint64_t imu_ = 0, gnss_ = 0, frames_ = 0, clouds_ = 0, scans_ = 0;
+};
+
+int run(const semap::onboard::OnboardConfig& config, const std::string& report_dir) {
   using namespace semap;
   auto log = common::logger("onboard");
   SpscRing<common::ImuSample> imu_ring(config.imu.ring, OverflowPolicy::kDropOldest);
@@ -130,6 +156,8 @@ int run(const semap::onboard::OnboardConfig& config) {
   if (config.rig.simulated) {
     rig = std::make_unique<onboard::SimRig>(config, imu_ring, colour_ring, depth_ring);
   }
+  std::unique_ptr<onboard::SimReport> report;
+  if (!report_dir.empty()) report = std::make_unique<onboard::SimReport>(*rig, report_dir);
 
   std::unique_ptr<drivers::GnssDriver> gnss_driver;
   auto gnss_config = config.gnss.driver;
@@ -162,9 +190,11 @@ int run(const semap::onboard::OnboardConfig& config) {
   }
   std::unique_ptr<drivers::CameraDriver> camera_driver;
   std::unique_ptr<drivers::CameraDriver> depth_driver;
-  if (perception_stage && !rig) {
+  // The simulated rig fills the rings itself, unless it shows its colour frames on a V4L2
+  // output (rig.camera_output): the camera driver captures them back.
+  if (perception_stage && (!rig || !config.rig.camera_output.empty())) {
     camera_driver = std::make_unique<drivers::CameraDriver>(config.camera.driver, colour_ring);
-    if (config.depth.source == onboard::DepthSource::kAligned) {
+    if (!rig && config.depth.source == onboard::DepthSource::kAligned) {
       depth_driver = std::make_unique<drivers::CameraDriver>(config.depth.driver, depth_ring);
     }
   }
@@ -190,6 +220,12 @@ int run(const semap::onboard::OnboardConfig& config) {
   if (camera_driver) camera_driver->start();
   if (depth_driver) depth_driver->start();
   estimation_stage.start();
+  if (perception_stage && report) {
+    perception_stage->set_observer([&](std::uint32_t sequence, common::Stamp, const cv::Mat& bgr,
+                                       const perception::Segmentation& segmentation) {
+      report->observe(sequence, bgr, segmentation);
+    });
+  }
   if (perception_stage) perception_stage->start();
   mapping_stage.start();
   if (rig) rig->start();
@@ -200,11 +236,13 @@ int run(const semap::onboard::OnboardConfig& config) {
   auto next_report = started + 5.0;
   const Rings rings{imu_ring, gnss_ring, colour_ring, depth_ring, cloud_ring};
   onboard::HealthMonitor health;
+  Progress progress;
   auto next_health = started;
   while (!g_stop.load()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const auto est = estimation_stage.stats();
     if (rig) accuracy.sample(*rig, est);
+    if (report) report->sample_pose(est);
     const auto now = common::Stamp::now();
     if (dds && now >= next_health) {
       next_health = now + 1.0;
@@ -224,12 +262,10 @@ int run(const semap::onboard::OnboardConfig& config) {
     }
     if (now >= next_report) {
       next_report = now + 5.0;
-      const auto map = mapping_stage.stats();
-      const auto frames = perception_stage ? perception_stage->stats().clouds : 0;
-      log->info("t={:.0f}s imu={} gnss={} init={} frames={} scans={} blocks={} odom_out={}",
-                common::seconds_between(now, started), est.imu_samples, est.gnss_fixes,
-                est.initialised, frames, map.scans, map.map.blocks,
-                dds ? dds->odometry_written() : 0);
+      log->info("{}", progress.line(common::seconds_between(now, started), est,
+                                    perception_stage ? perception_stage->stats()
+                                                     : onboard::PerceptionStageStats{},
+                                    mapping_stage.stats(), rings));
     }
     if (rig && rig->finished()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the stages drain
@@ -256,6 +292,11 @@ int run(const semap::onboard::OnboardConfig& config) {
     mapping::write_smap(config.map_save_path,
                         mapping::to_layered_map(mapping_stage.map(), config.robot_id));
     log->info("map saved to {}", config.map_save_path);
+  }
+  if (report) {
+    const auto path = report->dir() / "map.smap";
+    mapping::write_smap(path, mapping::to_layered_map(mapping_stage.map(), config.robot_id));
+    log->info("map saved to {}", path.string());
   }
   std::printf("\n== semap-onboard summary ==\n");
   if (gnss_driver) {
@@ -319,9 +360,25 @@ int run(const semap::onboard::OnboardConfig& config) {
   getrusage(RUSAGE_SELF, &usage);
   const double cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
                        1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-  std::printf("cpu              : %.2f cores over %.1f s\n",
-              cpu_s / common::seconds_between(common::Stamp::now(), started),
-              common::seconds_between(common::Stamp::now(), started));
+  const double wall_s = common::seconds_between(common::Stamp::now(), started);
+  std::printf("cpu              : %.2f cores over %.1f s\n", cpu_s / wall_s, wall_s);
+  if (report) {
+    onboard::RunFigures figures;
+    figures.segmenter =
+        config.segmenter.kind == onboard::SegmenterConfig::Kind::kOnnx ? "onnx" : "palette";
+    if (accuracy.any()) figures.pose_rmse_m = accuracy.rmse();
+    figures.frames_captured = rig->camera().rendered();
+    figures.frames_mapped = map.scans;
+    figures.latency_frame_to_map = mapping_stage.latency().percentiles();
+    figures.ring_drops = {{"imu", drops(imu_ring)},
+                          {"gnss", drops(gnss_ring)},
+                          {"colour", drops(colour_ring)},
+                          {"depth", drops(depth_ring)},
+                          {"clouds", drops(cloud_ring)}};
+    figures.cpu_cores_used = cpu_s / wall_s;
+    const auto summary = report->write(figures, mapping_stage.map(), est);
+    std::printf("report           : %s\n", summary.c_str());
+  }
   // Without a camera an empty map is expected; a filter that never initialised is a failure
   // either way.
   const bool mapped = !camera || map.scans > 0;
@@ -338,9 +395,13 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   std::optional<int> domain;
+  std::string report_dir;
   app.add_option("--duration", duration, "seconds to run; overrides rig.duration_s (0: Ctrl-C)");
   app.add_option("--domain", domain, "DDS domain id; overrides dds.domain")
       ->check(CLI::Range(0, 232));
+  app.add_option("--report", report_dir,
+                 "simulated rig only: write camera.png, trajectory.png, map.smap and "
+                 "summary.json into this directory");
   CLI11_PARSE(app, argc, argv);
 
   semap::onboard::OnboardConfig config;
@@ -348,6 +409,10 @@ int main(int argc, char** argv) {
     config = semap::onboard::load_onboard_config(config_path);
   } catch (const std::exception& e) {
     std::cerr << "semap-onboard: " << e.what() << "\n";
+    return 2;
+  }
+  if (!report_dir.empty() && !config.rig.simulated) {
+    std::cerr << "semap-onboard: --report needs the simulated rig (rig.kind: sim)\n";
     return 2;
   }
   if (duration) config.rig.duration_s = *duration;
@@ -359,7 +424,7 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
-    return run(config);
+    return run(config, report_dir);
   } catch (const std::exception& e) {
     std::cerr << "semap-onboard: " << e.what() << "\n";
     return 1;

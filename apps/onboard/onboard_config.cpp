@@ -40,6 +40,7 @@ void read_rig(const ConfigSection& s, RigConfig& rig) {
   rig.camera_image = s.get_choice("camera_image", "rgb", {"rgb", "classes"}) == "rgb"
                          ? SimCameraImage::kRgb
                          : SimCameraImage::kClasses;
+  rig.camera_output = s.get<std::string>("camera_output", "");
   s.finish();
 }
 
@@ -192,6 +193,8 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   c.map_save_path = map.get<std::string>("save_path", "");
   c.map_threads = static_cast<int>(map.get_in_range("threads", 2, 1, 64));
   c.robot_id = static_cast<mapping::SourceId>(map.get_in_range("robot_id", 1, 1, 65535));
+  c.map_start_heading_sigma_deg =
+      map.get_in_range("start_heading_sigma_deg", c.map_start_heading_sigma_deg, 0.01, 180.0);
   map.finish();
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);
@@ -199,6 +202,23 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   if (c.rig.simulated && c.depth.source != DepthSource::kAligned) {
     throw common::ConfigError(path.string() +
                               ": key 'depth.source': the simulated rig renders aligned depth only");
+  }
+  if (!c.rig.camera_output.empty()) {
+    if (!c.rig.simulated) {
+      root.section("rig").reject("camera_output", "only the simulated rig writes camera frames");
+    }
+    // The frames come back at the device's capture rate, each one repeated until the next; a
+    // colour frame pairs with the depth frame within the tolerance, which must therefore stay
+    // below half the rig's frame period (see SimCameraFeed).
+    if (c.depth.sync_tolerance_s >= 0.5 / c.camera.driver.fps) {
+      root.section_or_empty("depth").reject(
+          "sync_tolerance_ms",
+          "must be below half the camera's frame period with rig.camera_output");
+    }
+    // The rig writes BGR24 and the capture side must ask for the same format.
+    const auto camera = root.section_or_empty("camera");
+    if (camera.has("format")) camera.reject("format", "rig.camera_output sets it (BGR24)");
+    c.camera.driver.format = common::PixelFormat::kBgr24;
   }
   c.map.validate();
   return c;

@@ -26,6 +26,10 @@ struct RigConfig {
   std::uint32_t scene_seed = 7;  // the street world and the camera's noise
   double world_density = 1.0;    // scales the number of buildings, trees, cars and poles
   SimCameraImage camera_image = SimCameraImage::kRgb;
+  // A V4L2 video output device (vivid's, looped to its capture side): the rig writes its colour
+  // frames there as BGR24 and a CameraDriver on camera.device captures them back. Empty: the
+  // frames go straight into the colour ring.
+  std::string camera_output;
 };
 
 struct ImuSourceConfig {
@@ -70,6 +74,9 @@ struct OnboardConfig {
   std::string map_save_path;       // .smap written at exit when set
   mapping::SourceId robot_id = 1;  // this robot's evidence layer in saved and merged maps
   int map_threads = 2;
+  // Frames are mapped only once the filter's heading is known to within this (1 sigma):
+  // a filter that starts from a guessed heading would otherwise smear the map.
+  double map_start_heading_sigma_deg = 3.0;
   DdsConfig dds;
   std::string log_level = "info";
 };

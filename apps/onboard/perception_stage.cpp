@@ -219,6 +219,7 @@ void PerceptionStage::process(const common::ImageFrame& colour, const common::Im
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     local_.segment_seconds_total += seconds;
     local_.segment_seconds_max = std::max(local_.segment_seconds_max, seconds);
+    if (observer_) observer_(colour.sequence, colour.stamp, image, segmentation);
     BodyCloud body{perception::cloud_from_depth(depth_m, segmentation, intrinsics,
                                                 body_from_optical, depth_.points, local_.dropped),
                    colour.sequence};

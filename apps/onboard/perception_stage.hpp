@@ -1,6 +1,7 @@
 #pragma once
 
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -51,6 +52,14 @@ class PerceptionStage {
   PerceptionStage(const PerceptionStage&) = delete;
   PerceptionStage& operator=(const PerceptionStage&) = delete;
 
+  // Called on the stage's thread after each segmentation with the colour frame's sequence and
+  // stamp, the BGR image the segmenter saw and its result (evaluation on the simulated rig).
+  // It delays the stage while it runs. Set before start().
+  using SegmentationObserver =
+      std::function<void(std::uint32_t sequence, common::Stamp stamp, const cv::Mat& bgr,
+                         const perception::Segmentation&)>;
+  void set_observer(SegmentationObserver observer) { observer_ = std::move(observer); }
+
   void start();
   void stop();
   PerceptionStageStats stats() const;
@@ -82,6 +91,7 @@ class PerceptionStage {
   CameraConfig camera_;
   DepthConfig depth_;
   std::unique_ptr<perception::Segmenter> segmenter_;
+  SegmentationObserver observer_;
   std::unique_ptr<perception::StereoDepth> stereo_;
   common::SpscRing<common::ImageFrame>& colour_ring_;
   common::SpscRing<common::ImageFrame>* depth_ring_;

@@ -1,9 +1,12 @@
 #include "sim_camera_feed.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <opencv2/core.hpp>
 
+#include "semap/common/logging.hpp"
+#include "semap/drivers/driver_error.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 
 namespace semap::onboard {
@@ -49,13 +52,15 @@ cv::Mat paint_classes(const cv::Mat& train_ids) {
 SimCameraFeed::SimCameraFeed(const perception::SimWorld& world,
                              const perception::SimCameraOptions& camera, SimCameraImage image,
                              float depth_scale, common::SpscRing<common::ImageFrame>& colour_ring,
-                             common::SpscRing<common::ImageFrame>& depth_ring)
+                             common::SpscRing<common::ImageFrame>& depth_ring,
+                             SimCameraOutput output)
     : world_(world),
       camera_(camera),
       image_(image),
       depth_scale_(depth_scale),
       colour_ring_(colour_ring),
-      depth_ring_(depth_ring) {}
+      depth_ring_(depth_ring),
+      output_(std::move(output)) {}
 
 SimCameraFeed::~SimCameraFeed() { stop(); }
 
@@ -80,6 +85,10 @@ void SimCameraFeed::request(const Eigen::Isometry3f& world_from_optical, common:
   wake_.notify_one();
 }
 
+double SimCameraFeed::request_ahead_s() const {
+  return output_.device ? output_.period_s + output_lead_s() : 0.0;
+}
+
 std::optional<cv::Mat> SimCameraFeed::true_labels(std::uint32_t sequence) const {
   std::lock_guard lock(mutex_);
   for (const auto& [s, labels] : truth_) {
@@ -96,6 +105,11 @@ std::uint64_t SimCameraFeed::rendered() const {
 std::uint64_t SimCameraFeed::skipped() const {
   std::lock_guard lock(mutex_);
   return skipped_;
+}
+
+std::uint64_t SimCameraFeed::not_shown() const {
+  std::lock_guard lock(mutex_);
+  return not_shown_;
 }
 
 double SimCameraFeed::render_seconds_mean() const {
@@ -126,17 +140,48 @@ void SimCameraFeed::run(std::stop_token stop) {
       ++rendered_;
       render_seconds_ += seconds;
     }
-    publish(frame, request.stamp, sequence);
+    publish(frame, request.stamp, sequence, stop);
     ++sequence;
   }
 }
 
 void SimCameraFeed::publish(const perception::SimFrame& frame, common::Stamp stamp,
-                            std::uint32_t sequence) {
+                            std::uint32_t sequence, std::stop_token stop) {
   const cv::Mat colour = image_ == SimCameraImage::kRgb ? frame.bgr : paint_classes(frame.labels);
-  colour_ring_.try_push(to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+  if (!output_.device) {
+    colour_ring_.try_push(to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+  } else if (!show(colour, stamp, stop)) {
+    std::lock_guard lock(mutex_);
+    ++not_shown_;
+    return;
+  }
   depth_ring_.try_push(to_frame(perception::depth_to_z16(frame.depth_m, depth_scale_),
                                 common::PixelFormat::kZ16, stamp, sequence));
+}
+
+// Writes the frame to the output `period - tolerance` before its stamp (see SimCameraOutput);
+// false if it is too late for that by more than half the loop's allowance, or on an error.
+bool SimCameraFeed::show(const cv::Mat& colour, common::Stamp stamp, std::stop_token stop) {
+  const common::Stamp due = stamp + (-output_lead_s());
+  const double allowance = output_.period_s - 2.0 * output_.tolerance_s;
+  if (common::Stamp::now() > due + 0.5 * allowance) return false;
+  {
+    std::unique_lock lock(mutex_);
+    const auto wait = std::chrono::nanoseconds(
+        std::max<std::int64_t>(0, static_cast<std::int64_t>(due.ns - common::Stamp::now().ns)));
+    wake_.wait_for(lock, stop, wait, [] { return false; });
+  }
+  if (stop.stop_requested()) return false;
+  try {
+    if (output_.device->write({colour.data, colour.total() * colour.elemSize()}, colour.step,
+                              100)) {
+      return true;
+    }
+    common::logger("sim_camera")->warn("{}: no output buffer came back", output_.device->path());
+  } catch (const drivers::DriverError& e) {
+    common::logger("sim_camera")->warn("camera frame not shown: {}", e.what());
+  }
+  return false;
 }
 
 }  // namespace semap::onboard

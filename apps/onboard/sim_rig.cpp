@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "semap/common/logging.hpp"
+#include "semap/drivers/frame_convert.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
 #include "semap/firmware_bridge/sensor_source.hpp"
 
@@ -66,8 +67,28 @@ SimRig::SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>&
   perception::SimCameraOptions camera;
   camera.intrinsics = config.camera.intrinsics;
   camera.seed = config.rig.scene_seed;
+  SimCameraOutput output;
+  if (!config.rig.camera_output.empty()) {
+    const auto& c = config.camera.driver;
+    output.device = std::make_unique<drivers::V4l2Output>(config.rig.camera_output);
+    const auto format = output.device->set_format(drivers::to_fourcc(common::PixelFormat::kBgr24),
+                                                  c.width, c.height);
+    if (format.width != c.width || format.height != c.height) {
+      throw std::runtime_error("sim rig: " + config.rig.camera_output + " offers " +
+                               std::to_string(format.width) + "x" + std::to_string(format.height) +
+                               " for camera frames of " + std::to_string(c.width) + "x" +
+                               std::to_string(c.height));
+    }
+    output.device->start(c.buffers);
+    output.period_s = 1.0 / c.fps;
+    output.tolerance_s = config.depth.sync_tolerance_s;
+    common::logger("sim_rig")->info("camera frames to {} ({}): BGR24 {}x{}, {:.0f} ms ahead",
+                                    config.rig.camera_output, output.device->card(), c.width,
+                                    c.height, 1e3 * (output.period_s - output.tolerance_s));
+  }
   camera_ = std::make_unique<SimCameraFeed>(world_, camera, config.rig.camera_image,
-                                            config.depth.depth_scale, colour_ring, depth_ring);
+                                            config.depth.depth_scale, colour_ring, depth_ring,
+                                            std::move(output));
   firmware_bridge::EmulatorConfig emu;
   emu.gnss_protocol = config.gnss.protocol;
   emu.speed = 0.0;  // the rig paces events itself
@@ -122,18 +143,26 @@ std::optional<estimation::TruthSample> SimRig::truth_at(common::Stamp stamp) con
   return *it;
 }
 
-void SimRig::request_frame(const estimation::TruthSample& truth, common::Stamp stamp) {
+// A frame at the first true pose at or after this simulated time, stamped with its time.
+void SimRig::request_frame(common::Stamp sim_stamp) {
+  const auto it = std::lower_bound(data_.truth.begin(), data_.truth.end(), sim_stamp,
+                                   [](const auto& t, common::Stamp s) { return t.stamp < s; });
+  if (it == data_.truth.end()) return;
+  const auto& truth = *it;
   Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
   world_from_body.linear() = truth.state.rotation.cast<float>();
   world_from_body.translation() = truth.state.position.cast<float>();
-  camera_->request(world_from_body * body_from_optical_, stamp);
+  camera_->request(world_from_body * body_from_optical_, common::Stamp(start_.ns + truth.stamp.ns));
 }
 
 void SimRig::run(std::stop_token stop) {
   auto log = common::logger("sim_rig");
   const double duration = config_.rig.duration_s > 0 ? config_.rig.duration_s : 1e12;
   const double camera_period = 1.0 / config_.camera.driver.fps;
-  double next_camera = data_.truth.empty() ? 0.0 : data_.truth.front().stamp.seconds();
+  const double camera_ahead = camera_->request_ahead_s();
+  // Asked for ahead, the first frames would be late already.
+  double next_camera =
+      data_.truth.empty() ? 0.0 : data_.truth.front().stamp.seconds() + camera_ahead;
   firmware_bridge::VectorSource source(data_.imu, data_.gnss);
   std::size_t imu_index = 0;
   while (!stop.stop_requested()) {
@@ -151,17 +180,20 @@ void SimRig::run(std::stop_token stop) {
         restamped.stamp = wall;
         imu_ring_.try_push(restamped);
       }
-      const auto& truth = data_.truth[std::min(imu_index++, data_.truth.size() - 1)];
-      if (sim_stamp.seconds() >= next_camera) {
-        request_frame(truth, wall);
+      ++imu_index;
+      if (sim_stamp.seconds() + camera_ahead >= next_camera) {
+        request_frame(common::Stamp::from_seconds(next_camera));
         next_camera += camera_period;
       }
     } else if (pty_master_ >= 0) {
       emulator_->emit(*event);
     }
   }
-  log->info("simulated drive finished: {} IMU samples, {} GNSS epochs, {} frames rendered",
-            imu_index, emulator_->stats().gnss_epochs, camera_->rendered());
+  log->info(
+      "simulated drive finished: {} IMU samples, {} GNSS epochs, {} frames rendered (mean {:.0f} "
+      "ms), {} not shown on time",
+      imu_index, emulator_->stats().gnss_epochs, camera_->rendered(),
+      1e3 * camera_->render_seconds_mean(), camera_->not_shown());
   finished_.store(true, std::memory_order_release);
 }
 

@@ -21,8 +21,9 @@ namespace semap::onboard {
 // straight into the IMU ring otherwise, and camera frames of a synthetic world seen from the
 // true pose in a procedural street world (SimWorld): a colour frame, rendered or painted in
 // class colours (rig.camera_image), and an aligned Z16 depth frame, into the rings a colour
-// camera driver and a depth camera driver would fill (SimCameraFeed). Sensor stamps are
-// CLOCK_MONOTONIC, as real drivers would give them.
+// camera driver and a depth camera driver would fill (SimCameraFeed), or the colour frame to a
+// V4L2 output device (rig.camera_output) looped back to the capture device a real
+// CameraDriver reads. Sensor stamps are CLOCK_MONOTONIC, as real drivers would give them.
 class SimRig {
  public:
   SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu_ring,
@@ -48,7 +49,7 @@ class SimRig {
 
  private:
   void run(std::stop_token stop);
-  void request_frame(const estimation::TruthSample& truth, common::Stamp stamp);
+  void request_frame(common::Stamp sim_stamp);
 
   const OnboardConfig& config_;
   common::SpscRing<common::ImuSample>& imu_ring_;

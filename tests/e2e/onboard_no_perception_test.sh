@@ -8,9 +8,8 @@ export CYCLONEDDS_URI="file://$xml"
 domain=$(( (RANDOM % 200) + 20 ))
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-sed -e 's|^  kind: palette.*|  kind: onnx\n  model_card: '"$work"'/missing-card.yaml|' \
-    -e '/^  confidence: /d' -e 's|^  save_path: .*|  save_path: '"$work"'/map.smap|' \
-    "$config" >"$work/robot.yaml"
+sed -e 's|^  model_card: .*|  model_card: '"$work"'/missing-card.yaml|' \
+    -e 's|^  save_path: .*|  save_path: '"$work"'/map.smap|' "$config" >"$work/robot.yaml"
 grep -q "missing-card.yaml" "$work/robot.yaml" || { echo "config edit failed"; exit 1; }
 status=0
 "$onboard" --config "$work/robot.yaml" --duration 8 --domain "$domain" >"$work/onboard.log" 2>&1 ||

@@ -1,8 +1,10 @@
-// semap-onboard, the robot's main job, on a hardware configuration against kernel devices:
+// semap-onboard, the robot's main job, against kernel devices. On a hardware configuration:
 // IMU CAN frames on vcan0 and GNSS NMEA on a pty from semap-sensor-sim, the vivid virtual
 // camera as a side-by-side stereo camera (depth by semi-global matching) and an ONNX segmenter.
-// Natively where the host has vcan0 and vivid, otherwise inside scripts/hil-qemu, which copies
-// both programs next to this binary (see docs/hil.md).
+// On the simulated rig: its IMU as CAN frames on vcan0, its GNSS on its pty and its camera
+// frames through vivid's output-to-capture loop into the real CameraDriver; the saved map is
+// read back by semap-export. Natively where the host has vcan0 and vivid, otherwise inside
+// scripts/hil-qemu, which copies the programs next to this binary (see docs/hil.md).
 #include <fcntl.h>
 #include <linux/videodev2.h>
 #include <signal.h>
@@ -32,7 +34,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-constexpr double kRunSeconds = 20.0;  // semap-onboard --duration
+constexpr double kRunSeconds = 20.0;       // semap-onboard --duration
+constexpr double kPipelineSeconds = 30.0;  // the simulated rig's drive
 
 // The first vivid video capture node, or "" when there is none.
 std::string find_vivid() {
@@ -44,6 +47,30 @@ std::string find_vivid() {
     } catch (const DriverError&) {
       // not a capture node, or no such device
     }
+  }
+  return "";
+}
+
+// The video output node of the vivid instance whose capture node is `capture`, or "".
+std::string find_vivid_output(const std::string& capture) {
+  const auto bus = [](const std::string& path, std::uint32_t wanted) -> std::string {
+    const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+    if (fd < 0) return "";
+    v4l2_capability cap{};
+    const bool ok = ::ioctl(fd, VIDIOC_QUERYCAP, &cap) == 0;
+    ::close(fd);
+    const std::uint32_t caps =
+        (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
+    if (!ok || std::string(reinterpret_cast<const char*>(cap.driver)) != "vivid" ||
+        !(caps & wanted)) {
+      return "";
+    }
+    return reinterpret_cast<const char*>(cap.bus_info);
+  };
+  const std::string instance = bus(capture, V4L2_CAP_VIDEO_CAPTURE);
+  for (int i = 0; i < 16 && !instance.empty(); ++i) {
+    const std::string path = "/dev/video" + std::to_string(i);
+    if (bus(path, V4L2_CAP_VIDEO_OUTPUT) == instance) return path;
   }
   return "";
 }
@@ -165,6 +192,56 @@ std::optional<std::pair<std::uint32_t, std::int32_t>> set_menu_control(int fd,
   return std::nullopt;
 }
 
+// Sets an integer or boolean control by name; returns its id and the value it had.
+std::optional<std::pair<std::uint32_t, std::int32_t>> set_control(int fd, const std::string& name,
+                                                                  std::int32_t value,
+                                                                  std::string& error) {
+  v4l2_queryctrl q{};
+  q.id = V4L2_CTRL_FLAG_NEXT_CTRL;
+  while (::ioctl(fd, VIDIOC_QUERYCTRL, &q) == 0) {
+    if (name == reinterpret_cast<const char*>(q.name)) {
+      v4l2_control c{};
+      c.id = q.id;
+      if (::ioctl(fd, VIDIOC_G_CTRL, &c) != 0) {
+        error = name + ": VIDIOC_G_CTRL: " + std::strerror(errno);
+        return std::nullopt;
+      }
+      const std::int32_t old = c.value;
+      c.value = value;
+      if (::ioctl(fd, VIDIOC_S_CTRL, &c) != 0) {
+        error = name + ": VIDIOC_S_CTRL: " + std::strerror(errno);
+        return std::nullopt;
+      }
+      return std::pair{q.id, old};
+    }
+    q.id |= V4L2_CTRL_FLAG_NEXT_CTRL;
+  }
+  error = "no control '" + name + "'";
+  return std::nullopt;
+}
+
+double frame_rate(const v4l2_dv_timings& t) {
+  const auto& bt = t.bt;
+  return static_cast<double>(bt.pixelclock) /
+         (static_cast<double>(V4L2_DV_BT_FRAME_WIDTH(&bt)) * V4L2_DV_BT_FRAME_HEIGHT(&bt));
+}
+
+// The slowest of the device's DV timings whose frame vivid's scalers (at most 4x either way)
+// can bring to width x height: fewer captures of each rendered frame to copy.
+std::optional<v4l2_dv_timings> slowest_timings(int fd, std::uint32_t width, std::uint32_t height) {
+  std::optional<v4l2_dv_timings> best;
+  v4l2_enum_dv_timings e{};
+  for (e.index = 0; ::ioctl(fd, VIDIOC_ENUM_DV_TIMINGS, &e) == 0; ++e.index) {
+    const auto& bt = e.timings.bt;
+    if (bt.interlaced || bt.width < width || bt.height < height || bt.width > 4 * width ||
+        bt.height > 4 * height) {
+      continue;
+    }
+    if (!best || frame_rate(e.timings) < frame_rate(*best)) best = e.timings;
+  }
+  return best;
+}
+
 // The smallest YUYV size vivid offers that is at least 320 wide (its webcam input lists
 // discrete sizes: 320x180, 640x360, 640x480, ...).
 std::pair<std::uint32_t, std::uint32_t> smallest_yuyv_size(int fd) {
@@ -186,7 +263,8 @@ struct Summary {
   unsigned long camera_frames = 0, camera_bad = 0;
   unsigned long perception_frames = 0, clouds = 0, cloud_points = 0, perception_bad = 0;
   unsigned long scans = 0, blocks = 0;
-  std::string missing;  // summary lines not found
+  std::optional<double> pose_rmse;  // only on the simulated rig
+  std::string missing;              // summary lines not found
 };
 
 Summary parse_summary(const std::string& out) {
@@ -218,6 +296,9 @@ Summary parse_summary(const std::string& out) {
     s.scans = std::stoul(m[1]);
     s.blocks = std::stoul(m[2]);
   }
+  if (std::regex_search(out, m, std::regex(R"(pose vs truth +: position RMSE ([0-9.]+) m)"))) {
+    s.pose_rmse = std::stod(m[1]);
+  }
   return s;
 }
 
@@ -243,8 +324,14 @@ class OnboardHil : public ::testing::Test {
         v4l2_control c{id, value};
         ::ioctl(fd_, VIDIOC_S_CTRL, &c);
       }
+      // Timings while the HDMI input and output are still selected, then the old ones.
+      if (old_timings_) ::ioctl(fd_, VIDIOC_S_DV_TIMINGS, &*old_timings_);
+      if (old_out_timings_) ::ioctl(out_fd_, VIDIOC_S_DV_TIMINGS, &*old_out_timings_);
+      if (old_output_) ::ioctl(out_fd_, VIDIOC_S_OUTPUT, &*old_output_);
+      if (old_input_) ::ioctl(fd_, VIDIOC_S_INPUT, &*old_input_);
       ::close(fd_);
     }
+    if (out_fd_ >= 0) ::close(out_fd_);
     if (!dir_.empty()) fs::remove_all(dir_);
   }
 
@@ -268,10 +355,66 @@ class OnboardHil : public ::testing::Test {
     set("OSD Text Mode", "None", false);
   }
 
+  // vivid loops its HDMI output to its HDMI input when both have the same timings and pixel
+  // format and "Loop Video" is on. Selects both, gives them the slowest timings that scale to
+  // width x height and switches the loop on; semap-onboard sets the formats.
+  void set_vivid_loop(const std::string& output, std::uint32_t width, std::uint32_t height) {
+    fd_ = ::open(camera_.c_str(), O_RDWR | O_CLOEXEC);
+    ASSERT_GE(fd_, 0) << camera_ << ": " << std::strerror(errno);
+    out_fd_ = ::open(output.c_str(), O_RDWR | O_CLOEXEC);
+    ASSERT_GE(out_fd_, 0) << output << ": " << std::strerror(errno);
+    int input = -1, out = -1;
+    v4l2_input in{};
+    for (in.index = 0; input < 0 && ::ioctl(fd_, VIDIOC_ENUMINPUT, &in) == 0; ++in.index) {
+      if (std::string(reinterpret_cast<const char*>(in.name)).starts_with("HDMI")) {
+        input = static_cast<int>(in.index);
+      }
+    }
+    v4l2_output o{};
+    for (o.index = 0; out < 0 && ::ioctl(out_fd_, VIDIOC_ENUMOUTPUT, &o) == 0; ++o.index) {
+      if (std::string(reinterpret_cast<const char*>(o.name)).starts_with("HDMI")) {
+        out = static_cast<int>(o.index);
+      }
+    }
+    ASSERT_TRUE(input >= 0 && out >= 0) << "vivid has no HDMI input or output";
+    int old = 0;
+    ASSERT_EQ(::ioctl(fd_, VIDIOC_G_INPUT, &old), 0) << std::strerror(errno);
+    ASSERT_EQ(::ioctl(fd_, VIDIOC_S_INPUT, &input), 0)
+        << "VIDIOC_S_INPUT: " << std::strerror(errno);
+    old_input_ = old;
+    ASSERT_EQ(::ioctl(out_fd_, VIDIOC_G_OUTPUT, &old), 0) << std::strerror(errno);
+    ASSERT_EQ(::ioctl(out_fd_, VIDIOC_S_OUTPUT, &out), 0)
+        << "VIDIOC_S_OUTPUT: " << std::strerror(errno);
+    old_output_ = old;
+    v4l2_dv_timings current{};
+    ASSERT_EQ(::ioctl(fd_, VIDIOC_G_DV_TIMINGS, &current), 0) << std::strerror(errno);
+    old_timings_ = current;
+    ASSERT_EQ(::ioctl(out_fd_, VIDIOC_G_DV_TIMINGS, &current), 0) << std::strerror(errno);
+    old_out_timings_ = current;
+    auto timings = slowest_timings(fd_, width, height);
+    ASSERT_TRUE(timings) << "no DV timings scale to " << width << "x" << height;
+    auto out_timings = *timings;
+    ASSERT_EQ(::ioctl(fd_, VIDIOC_S_DV_TIMINGS, &*timings), 0) << std::strerror(errno);
+    ASSERT_EQ(::ioctl(out_fd_, VIDIOC_S_DV_TIMINGS, &out_timings), 0) << std::strerror(errno);
+    std::string error;
+    const auto loop = set_control(fd_, "Loop Video", 1, error);
+    ASSERT_TRUE(loop) << camera_ << ": " << error;
+    restore_.push_back(*loop);
+    if (const auto osd = set_menu_control(fd_, "OSD Text Mode", "None", error)) {
+      restore_.push_back(*osd);
+    }
+    std::printf("vivid: %s -> %s, HDMI %ux%u at %.2f Hz scaled to %ux%u, Loop Video on\n",
+                output.c_str(), camera_.c_str(), timings->bt.width, timings->bt.height,
+                frame_rate(*timings), width, height);
+  }
+
   std::string onboard_, sensor_sim_, camera_;
   fs::path dir_;
   int fd_ = -1;
   std::vector<std::pair<std::uint32_t, std::int32_t>> restore_;
+  int out_fd_ = -1;
+  std::optional<int> old_input_, old_output_;
+  std::optional<v4l2_dv_timings> old_timings_, old_out_timings_;
 };
 
 // The stereo calibration of the side-by-side frame. vivid shows the same checkers in both
@@ -446,6 +589,105 @@ TEST_F(OnboardHil, MapsFromVividStereoWithImuOnVcanAndGnssOnPty) {
   EXPECT_GT(s.cloud_points, 0u);
   EXPECT_GT(s.scans, 0u);
   EXPECT_GT(s.blocks, 0u);
+}
+
+// semap-onboard on its simulated rig (config/sim.yaml cut down for TCG): IMU as CAN frames on
+// vcan0, GNSS NMEA on the rig's pty, 320x180 colour frames at 2 Hz through vivid's loop
+// (painted in class colours, which BGR24 carries exactly, for the palette segmenter), aligned
+// depth paired by stamp, a coarse map saved at exit.
+std::string pipeline_config(const fs::path& dir, const std::string& output,
+                            const std::string& capture) {
+  std::ostringstream c;
+  c << "log_level: info\n"
+    << "rig:\n"
+    << "  kind: sim\n"
+    << "  scenario: figure8\n"
+    << "  speed_m_s: 2\n"
+    << "  gnss_rate_hz: 5\n"
+    << "  gnss_sigma_m: 0.3\n"
+    << "  camera_image: classes\n"
+    << "  camera_output: " << output << "\n"
+    << "imu:\n"
+    << "  interface: vcan0\n"
+    << "gnss:\n"
+    << "  device: pty\n"
+    << "camera:\n"
+    << "  device: " << capture << "\n"
+    << "  width: 320\n"
+    << "  height: 180\n"
+    << "  fps: 2\n"
+    << "  fov_deg: 90\n"
+    << "  mount_xyz: [0.3, 0, 1.5]\n"
+    << "  mount_rpy_deg: [0, 10, 0]\n"
+    << "  ring: 16\n"
+    << "depth:\n"
+    << "  source: aligned\n"
+    << "  sync_tolerance_ms: 60\n"
+    << "  max_range: 10\n"
+    << "  stride: 4\n"
+    << "segmenter:\n"
+    << "  kind: palette\n"
+    << "map:\n"
+    << "  method: bki\n"
+    << "  resolution: 0.2\n"
+    << "  num_classes: 8\n"
+    << "  free_res: 2.0\n"
+    << "  ds_res: 0.4\n"
+    << "  max_range: 10\n"
+    << "  threads: 1\n"
+    << "  save_path: " << (dir / "map.smap").string() << "\n"
+    << "dds:\n"
+    << "  enabled: false\n";
+  return c.str();
+}
+
+TEST_F(OnboardHil, SimulatedRigOverVcanPtyAndVividLoopIsMappedAndSaved) {
+  const std::string output = find_vivid_output(camera_);
+  if (output.empty()) SEMAP_HIL_UNAVAILABLE("vivid has no video output node");
+  const std::string exporter = find_program("semap-export", SEMAP_EXPORT_BIN);
+  ASSERT_FALSE(exporter.empty()) << "semap-export not found";
+  ASSERT_NO_FATAL_FAILURE(set_vivid_loop(output, 320, 180));
+  write_file(dir_ / "onboard.yaml", pipeline_config(dir_, output, camera_));
+
+  const auto started = std::chrono::steady_clock::now();
+  Child onboard({onboard_, "--config", (dir_ / "onboard.yaml").string(), "--duration",
+                 std::to_string(kPipelineSeconds)},
+                dir_ / "onboard.log");
+  const auto code =
+      onboard.wait(std::chrono::milliseconds(static_cast<int>(1e3 * kPipelineSeconds)) + 120s);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const std::string out = onboard.output();
+  std::printf("---- semap-onboard (%.1f s) ----\n%s\n", wall, out.c_str());
+  std::fflush(stdout);
+  ASSERT_TRUE(code.has_value()) << "semap-onboard did not exit";
+  EXPECT_EQ(*code, 0);
+  const Summary s = parse_summary(out);
+  ASSERT_TRUE(s.missing.empty()) << "summary lines missing: " << s.missing;
+  EXPECT_TRUE(s.initialised);
+  ASSERT_TRUE(s.pose_rmse) << "no pose vs truth line";
+  EXPECT_LT(*s.pose_rmse, 1.0);
+  EXPECT_GT(s.imu_samples, 0u);
+  EXPECT_GT(s.gnss_fixes, 0u);
+  // Through the V4L2 driver, then segmented, posed and mapped.
+  EXPECT_GT(s.camera_frames, 0u);
+  EXPECT_EQ(s.camera_bad, 0u);
+  EXPECT_EQ(s.perception_bad, 0u);
+  EXPECT_GT(s.clouds, 0u);
+  EXPECT_GT(s.scans, 0u);
+  EXPECT_GT(s.blocks, 0u);
+
+  // The saved map loads: semap-export reads it and writes its occupied cells.
+  const fs::path ply = dir_ / "map.ply";
+  Child exporting({exporter, (dir_ / "map.smap").string(), "--ply", ply.string()},
+                  dir_ / "export.log");
+  const auto export_code = exporting.wait(120s);
+  std::printf("---- semap-export ----\n%s\n", exporting.output().c_str());
+  ASSERT_EQ(export_code, std::optional<int>(0)) << "semap-export";
+  std::smatch m;
+  const std::string header = read_file(ply).substr(0, 512);
+  ASSERT_TRUE(std::regex_search(header, m, std::regex(R"(element vertex (\d+))"))) << header;
+  EXPECT_GT(std::stoul(m[1]), 0u) << "no occupied cells in the saved map";
 }
 
 }  // namespace

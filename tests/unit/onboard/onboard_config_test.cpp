@@ -49,8 +49,10 @@ TEST(OnboardConfig, SimulatedRigExample) {
   // Aligned depth takes the colour camera's size unless the file says otherwise.
   EXPECT_EQ(c.depth.driver.width, 640u);
   EXPECT_EQ(c.depth.driver.format, common::PixelFormat::kZ16);
-  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kPalette);
-  EXPECT_FLOAT_EQ(c.segmenter.confidence, 0.9f);
+  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
+  EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
+  EXPECT_EQ(c.rig.camera_image, SimCameraImage::kRgb);
+  EXPECT_DOUBLE_EQ(c.map_start_heading_sigma_deg, 3.0);
   const auto segmenter = make_segmenter(c.segmenter, c.map.num_classes);
   EXPECT_EQ(segmenter->num_classes(), c.map.num_classes);
 }
@@ -99,9 +101,10 @@ TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
                                 "source: stereo\n  calibration: x.yaml"))
                 .find("the simulated rig renders aligned depth only"),
             std::string::npos);
-  EXPECT_NE(error_of(edited_sim("kind: palette", "kind: onnx")).find("segmenter.model_card"),
+  EXPECT_NE(error_of(edited_sim("  model_card: models/semap-seg.yaml\n", ""))
+                .find("segmenter.model_card"),
             std::string::npos);
-  EXPECT_NE(error_of(edited_sim("confidence: 0.9", "confidence: 0.9\n  colour: red"))
+  EXPECT_NE(error_of(edited_sim("kind: onnx ", "colour: red\n  kind: onnx "))
                 .find("segmenter.colour"),
             std::string::npos);
 }

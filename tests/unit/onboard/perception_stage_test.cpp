@@ -219,6 +219,44 @@ TEST_F(PerceptionStageTest, RejectsBadFramesAndKeepsGoing) {
   EXPECT_EQ(stage->stats().clouds, 1u);
 }
 
+TEST_F(PerceptionStageTest, ShowsEachSegmentationToTheObserver) {
+  auto stage = make_stage();
+  struct Seen {
+    std::uint32_t sequence;
+    Stamp stamp;
+    cv::Mat bgr;
+    perception::Segmentation segmentation;
+  };
+  std::vector<Seen> seen;
+  stage->set_observer([&](std::uint32_t sequence, Stamp stamp, const cv::Mat& bgr,
+                          const perception::Segmentation& segmentation) {
+    seen.push_back({sequence, stamp, bgr.clone(), segmentation});
+  });
+  push_pair(0.5, 3);  // segmented, then dropped without a pose: the observer still sees it
+  stage->step();
+  poses_.append(drive(1.0, 2.0));
+  push_pair(1.5, 4);
+  stage->step();
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_EQ(seen[0].sequence, 3u);
+  EXPECT_EQ(seen[1].sequence, 4u);
+  EXPECT_EQ(seen[1].stamp, at(1.5));
+  ASSERT_EQ(seen[1].bgr.type(), CV_8UC3);
+  ASSERT_EQ(seen[1].bgr.size(), cv::Size(kWidth, kHeight));
+  EXPECT_EQ(seen[1].bgr.at<cv::Vec3b>(kHeight - 1, 0), cv::Vec3b(128, 64, 128));
+  const cv::Mat& labels = seen[1].segmentation.labels;
+  ASSERT_EQ(labels.size(), cv::Size(kWidth, kHeight));
+  EXPECT_EQ(labels.at<std::uint16_t>(0, 0), perception::kNoLabel);  // the unknown top row
+  EXPECT_EQ(labels.at<std::uint16_t>(kHeight - 1, 0), 1);           // road
+  // A bad frame is never segmented, so never observed.
+  auto truncated = colour_frame(1.6, 5);
+  truncated.data.resize(10);
+  colour_.try_push(truncated);
+  depth_ring_.try_push(depth_frame(1.6, 5));
+  stage->step();
+  EXPECT_EQ(seen.size(), 2u);
+}
+
 TEST_F(PerceptionStageTest, RefusesAlignedDepthWithoutADepthRing) {
   EXPECT_THROW(PerceptionStage(camera_, depth_,
                                std::make_unique<perception::PaletteSegmenter>(

@@ -91,7 +91,7 @@ TEST(ShippedModel, LoadsAndLabelsTheDemoWorld) {
   std::printf("shipped model, demo world: pixel mIoU %.3f over %d classes, %llu hits unlabelled\n",
               miou, classes, static_cast<unsigned long long>(unlabelled_hits));
   EXPECT_GE(classes, 6);
-  EXPECT_GT(miou, 0.6);
+  EXPECT_GT(miou, 0.75);  // 0.83 when the model was shipped
 }
 
 }  // namespace
