@@ -104,9 +104,9 @@ TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
   EXPECT_NE(error_of(edited_sim("  model_card: models/semap-seg.yaml\n", ""))
                 .find("segmenter.model_card"),
             std::string::npos);
-  EXPECT_NE(error_of(edited_sim("kind: onnx ", "colour: red\n  kind: onnx "))
-                .find("segmenter.colour"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(edited_sim("kind: onnx ", "colour: red\n  kind: onnx ")).find("segmenter.colour"),
+      std::string::npos);
 }
 
 TEST(OnboardConfig, SegmenterMustFitTheMap) {
