@@ -524,6 +524,8 @@ std::string onboard_config(const fs::path& dir, const std::string& camera, std::
     << "  ds_res: 0.2\n"
     << "  max_range: 10\n"
     << "  threads: 1\n"
+    // A slow circle leaves the heading poorly observed for long: map from initialisation.
+    << "  start_heading_sigma_deg: 180\n"
     << "dds:\n"
     << "  enabled: false\n";
   return c.str();
@@ -635,6 +637,8 @@ std::string pipeline_config(const fs::path& dir, const std::string& output,
     << "  ds_res: 0.4\n"
     << "  max_range: 10\n"
     << "  threads: 1\n"
+    // Few frames at 2 Hz: map from initialisation rather than wait for the heading.
+    << "  start_heading_sigma_deg: 180\n"
     << "  save_path: " << (dir / "map.smap").string() << "\n"
     << "dds:\n"
     << "  enabled: false\n";
