@@ -20,6 +20,8 @@ std::string frame_name(const common::ImageFrame& f) {
          std::to_string(f.height) + ", stamp " + std::to_string(f.stamp.ns) + " ns)";
 }
 
+}  // namespace
+
 common::LabeledCloud to_world(common::LabeledCloud cloud, const estimation::StampedPose& pose) {
   Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
   world_from_body.linear() = pose.orientation.toRotationMatrix().cast<float>();
@@ -28,8 +30,6 @@ common::LabeledCloud to_world(common::LabeledCloud cloud, const estimation::Stam
   cloud.origin = world_from_body * cloud.origin;
   return cloud;
 }
-
-}  // namespace
 
 PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& depth,
                                  std::unique_ptr<perception::Segmenter> segmenter,

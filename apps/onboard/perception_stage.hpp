@@ -109,4 +109,7 @@ class PerceptionStage {
   std::jthread thread_;
 };
 
+// A body-frame cloud in the world frame, with the robot at `pose`.
+common::LabeledCloud to_world(common::LabeledCloud cloud, const estimation::StampedPose& pose);
+
 }  // namespace semap::onboard

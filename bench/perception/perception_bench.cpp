@@ -76,15 +76,6 @@ struct TempDir {
   ~TempDir() { std::filesystem::remove_all(path); }
 };
 
-common::LabeledCloud to_world(common::LabeledCloud cloud, const semap::estimation::StampedPose& p) {
-  Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
-  world_from_body.linear() = p.orientation.toRotationMatrix().cast<float>();
-  world_from_body.translation() = p.position.cast<float>();
-  for (auto& q : cloud.points) q = world_from_body * q;
-  cloud.origin = world_from_body * cloud.origin;
-  return cloud;
-}
-
 void per_stage(const Options& o, const onboard::OnboardConfig& config,
                const bench::SceneImages& scene, const bench::BenchModel& model) {
   const int n = o.frames;
@@ -145,7 +136,7 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
   common::LabeledCloud world;
   row("posing: SharedPoseHistory::at + to world (stride 1)", bench::time_ms(n, [&](int i) {
         const auto lookup = poses.at(common::Stamp::from_seconds((i + 0.37) / kCameraHz));
-        world = to_world(clouds[0], lookup.pose);
+        world = onboard::to_world(clouds[0], lookup.pose);
       }));
 
   tbb::task_arena arena(o.threads);
@@ -153,7 +144,7 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
     semap::mapping::SemanticMap map(config.map);
     const auto s = bench::time_ms(n, [&](int i) {
       const double t = i / kCameraHz;
-      common::LabeledCloud cloud = to_world(clouds[stride - 1], bench::circle_pose(t, {}));
+      common::LabeledCloud cloud = onboard::to_world(clouds[stride - 1], bench::circle_pose(t, {}));
       arena.execute([&] { map.insert(cloud, cloud.origin); });
     });
     const auto stats = map.stats();

@@ -12,6 +12,7 @@
 #include <cstring>
 
 #include "semap/drivers/driver_error.hpp"
+#include "v4l2_node.hpp"
 
 namespace semap::drivers {
 
@@ -27,23 +28,10 @@ std::string fourcc_to_string(std::uint32_t fourcc) {
 }
 
 V4l2Device::V4l2Device(const std::string& path) : path_(path) {
-  fd_ = ::open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
-  if (fd_ < 0) throw_errno("open " + path);
-  v4l2_capability cap{};
-  try {
-    xioctl(VIDIOC_QUERYCAP, &cap, "VIDIOC_QUERYCAP");
-  } catch (...) {
-    ::close(fd_);
-    throw;
-  }
-  const std::uint32_t caps =
-      (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
-  card_ = reinterpret_cast<const char*>(cap.card);
-  driver_ = reinterpret_cast<const char*>(cap.driver);
-  if (!(caps & V4L2_CAP_VIDEO_CAPTURE) || !(caps & V4L2_CAP_STREAMING)) {
-    ::close(fd_);
-    throw DriverError(path + ": not a streaming video capture device (" + card_ + ")", ENOTSUP);
-  }
+  V4l2Node node = open_v4l2_node(path, V4L2_CAP_VIDEO_CAPTURE, "capture");
+  fd_ = node.fd;
+  card_ = std::move(node.card);
+  driver_ = std::move(node.driver);
 }
 
 V4l2Device::~V4l2Device() {
@@ -52,12 +40,7 @@ V4l2Device::~V4l2Device() {
 }
 
 int V4l2Device::xioctl(unsigned long request, void* arg, const char* name) const {
-  int r;
-  do {
-    r = ::ioctl(fd_, request, arg);
-  } while (r < 0 && errno == EINTR);
-  if (r < 0) throw_errno(path_ + ": " + name);
-  return r;
+  return v4l2_ioctl(fd_, path_, request, arg, name);
 }
 
 std::vector<V4l2FormatInfo> V4l2Device::formats() const {

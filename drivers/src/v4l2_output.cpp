@@ -12,26 +12,14 @@
 #include <cstring>
 
 #include "semap/drivers/driver_error.hpp"
+#include "v4l2_node.hpp"
 
 namespace semap::drivers {
 
 V4l2Output::V4l2Output(const std::string& path) : path_(path) {
-  fd_ = ::open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
-  if (fd_ < 0) throw_errno("open " + path);
-  v4l2_capability cap{};
-  try {
-    xioctl(VIDIOC_QUERYCAP, &cap, "VIDIOC_QUERYCAP");
-  } catch (...) {
-    ::close(fd_);
-    throw;
-  }
-  const std::uint32_t caps =
-      (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
-  card_ = reinterpret_cast<const char*>(cap.card);
-  if (!(caps & V4L2_CAP_VIDEO_OUTPUT) || !(caps & V4L2_CAP_STREAMING)) {
-    ::close(fd_);
-    throw DriverError(path + ": not a streaming video output device (" + card_ + ")", ENOTSUP);
-  }
+  V4l2Node node = open_v4l2_node(path, V4L2_CAP_VIDEO_OUTPUT, "output");
+  fd_ = node.fd;
+  card_ = std::move(node.card);
 }
 
 V4l2Output::~V4l2Output() {
@@ -40,12 +28,7 @@ V4l2Output::~V4l2Output() {
 }
 
 int V4l2Output::xioctl(unsigned long request, void* arg, const char* name) const {
-  int r;
-  do {
-    r = ::ioctl(fd_, request, arg);
-  } while (r < 0 && errno == EINTR);
-  if (r < 0) throw_errno(path_ + ": " + name);
-  return r;
+  return v4l2_ioctl(fd_, path_, request, arg, name);
 }
 
 V4l2Format V4l2Output::set_format(std::uint32_t fourcc, std::uint32_t width, std::uint32_t height) {
