@@ -23,7 +23,7 @@ constexpr float kPrior = 0.001f;
 // A floor of class 1 under the robot's path, with walls of class 2 at its edge, the rest free
 // (class 0). Each version adds one observation of every cell's class to its evidence (alpha
 // minus the prior, as the mapping stage publishes it), so fusion has evidence to merge.
-sd::BlockSnapshot synthetic_block(sd::BlockIndex index, const sd::MapDescription& d,
+sd::BlockSnapshot synthetic_block(semap::common::BlockIndex index, const sd::MapDescription& d,
                                   std::uint32_t version) {
   sd::BlockSnapshot b =
       sd::BlockSnapshot::empty(index, d.resolution, d.block_cells, d.num_classes, true);
@@ -39,7 +39,7 @@ sd::BlockSnapshot synthetic_block(sd::BlockIndex index, const sd::MapDescription
     } else if (std::fabs(r - 10.0f) < d.resolution && c.z() < 2.0f) {
       cls = static_cast<std::uint16_t>(std::min<int>(2, d.num_classes - 1));
     }
-    b.state[i] = cls == 0 ? sd::CellState::kFree : sd::CellState::kOccupied;
+    b.state[i] = cls == 0 ? semap::common::CellState::kFree : semap::common::CellState::kOccupied;
     b.argmax_class[i] = cls;
     b.evidence[i * k + cls] = observations;
     // Dirichlet variance of the argmax class' probability.
@@ -81,7 +81,8 @@ int main(int argc, char** argv) {
                                        sd::topic_qos(sd::SemapTopic::kOdometry));
     const std::string frame = "map";
     const std::string child = "base_link";
-    std::unordered_map<sd::BlockIndex, std::uint32_t, sd::BlockIndexHash> versions;
+    std::unordered_map<semap::common::BlockIndex, std::uint32_t, semap::common::BlockIndexHash>
+        versions;
     const auto start = std::chrono::steady_clock::now();
     std::cout << "publishing on " << sd::topic_name(dds.settings().ns, sd::SemapTopic::kOdometry)
               << " and " << sd::topic_name(dds.settings().ns, sd::SemapTopic::kMapBlocks)
@@ -100,11 +101,12 @@ int main(int argc, char** argv) {
       sd::to_msg(pose, frame, child, m);
       odom.write(m);
       // The robot "observes" the block under it and its neighbours.
-      const sd::BlockIndex here =
-          sd::block_of(pose.position.cast<float>(), desc.resolution, desc.block_cells);
+      const semap::common::BlockIndex here =
+          semap::common::MapGrid(desc.resolution, desc.block_cells)
+              .block_of(Eigen::Vector3f(pose.position.cast<float>()));
       for (int dx = -1; dx <= 1; ++dx) {
         for (int dy = -1; dy <= 1; ++dy) {
-          const sd::BlockIndex b{here.x + dx, here.y + dy, 0};
+          const semap::common::BlockIndex b{here.x + dx, here.y + dy, 0};
           map.update(synthetic_block(b, desc, ++versions[b]));
         }
       }

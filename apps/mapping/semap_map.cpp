@@ -70,8 +70,8 @@ int main(int argc, char** argv) {
       std::ofstream out(out_voxels);
       if (!out) throw std::runtime_error(out_voxels + ": cannot create");
       out << "x,y,z,label\n";
-      map.for_each_cell([&](const Eigen::Vector3f& c, const semap::mapping::CellPosterior& cell) {
-        if (cell.state(params.unknown_variance) == semap::mapping::CellState::kOccupied) {
+      map.for_each_cell([&](const Eigen::Vector3f& c, const semap::common::CellPosterior& cell) {
+        if (cell.state(params.unknown_variance) == semap::common::CellState::kOccupied) {
           out << c.x() << ',' << c.y() << ',' << c.z() << ',' << cell.argmax() << '\n';
         }
       });

@@ -4,40 +4,17 @@
 
 #include <chrono>
 
-#include "semap/mapping/cell_posterior.hpp"
-
 namespace semap::onboard {
 
-dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map,
-                                   const mapping::BlockIndex& index, const mapping::Block& block,
-                                   std::uint32_t version) {
+dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
+                                   const mapping::Block& block, std::uint32_t version) {
   const auto& params = map.params();
-  auto snap = dds_idl::BlockSnapshot::empty(dds_idl::BlockIndex{index.x, index.y, index.z},
-                                            params.resolution,
-                                            static_cast<std::uint16_t>(block.cells_per_side()),
-                                            static_cast<std::uint16_t>(block.num_classes()), true);
-  snap.version = version;
-  const auto evidence = block.evidence();
-  std::copy(evidence.begin(), evidence.end(), snap.evidence.begin());
+  std::vector<std::uint8_t> observed(static_cast<std::size_t>(block.num_cells()));
   for (int c = 0; c < block.num_cells(); ++c) {
-    const mapping::CellPosterior post(block.cell_evidence(c), params.prior, block.observed(c));
-    const auto cell = static_cast<std::size_t>(c);
-    switch (post.state(params.unknown_variance)) {
-      case mapping::CellState::kUnknown:
-        snap.state[cell] = dds_idl::CellState::kUnknown;
-        break;
-      case mapping::CellState::kFree:
-        snap.state[cell] = dds_idl::CellState::kFree;
-        break;
-      case mapping::CellState::kOccupied:
-        snap.state[cell] = dds_idl::CellState::kOccupied;
-        break;
-    }
-    const int k = post.argmax();
-    snap.argmax_class[cell] = static_cast<std::uint16_t>(k);
-    snap.variance[cell] = post.variance(k);
+    observed[static_cast<std::size_t>(c)] = block.observed(c) ? 1 : 0;
   }
-  return snap;
+  return dds_idl::snapshot_of_evidence(index, params.grid(), block.num_classes(), block.evidence(),
+                                       observed, params.prior, params.unknown_variance, version);
 }
 
 MappingStage::MappingStage(const OnboardConfig& config,
@@ -94,12 +71,12 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
 }
 
 std::vector<dds_idl::BlockSnapshot> MappingStage::snapshots_of(
-    const std::vector<mapping::BlockIndex>& updated) {
+    const std::vector<common::BlockIndex>& updated) {
   std::vector<dds_idl::BlockSnapshot> out;
   out.reserve(updated.size());
   for (const auto& index : updated) {
     if (const auto* block = map_.find_block(index)) {
-      const dds_idl::BlockIndex key{index.x, index.y, index.z};
+      const common::BlockIndex key{index.x, index.y, index.z};
       out.push_back(to_snapshot(map_, index, *block, ++versions_[key]));
     }
   }

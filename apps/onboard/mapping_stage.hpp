@@ -47,13 +47,13 @@ class MappingStage {
  private:
   void run(std::stop_token stop);
   void insert(const common::LabeledCloud& cloud);
-  std::vector<dds_idl::BlockSnapshot> snapshots_of(const std::vector<mapping::BlockIndex>& updated);
+  std::vector<dds_idl::BlockSnapshot> snapshots_of(const std::vector<common::BlockIndex>& updated);
 
   const OnboardConfig& config_;
   common::SpscRing<common::LabeledCloud>& clouds_;
   BlockSink sink_;
   mapping::SemanticMap map_;
-  std::unordered_map<dds_idl::BlockIndex, std::uint32_t, dds_idl::BlockIndexHash> versions_;
+  std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
   MappingStageStats local_;
   mutable std::mutex stats_mutex_;
   MappingStageStats shared_;
@@ -62,8 +62,7 @@ class MappingStage {
 };
 
 // A block of the map in the form the DDS layer publishes.
-dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map,
-                                   const mapping::BlockIndex& index, const mapping::Block& block,
-                                   std::uint32_t version);
+dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
+                                   const mapping::Block& block, std::uint32_t version);
 
 }  // namespace semap::onboard

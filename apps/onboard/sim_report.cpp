@@ -85,6 +85,19 @@ std::string per_class(const ClassConfusion& confusion) {
   return out + "}";
 }
 
+// Rows are true classes (free first), columns predicted classes then "no label".
+std::string confusion_rows(const ClassConfusion& confusion) {
+  std::string out = "[";
+  for (int t = 0; t < ClassConfusion::K; ++t) {
+    out += t ? ", [" : "[";
+    for (int p = 0; p <= ClassConfusion::K; ++p) {
+      out += (p ? ", " : "") + std::to_string(confusion.count(t, p));
+    }
+    out += "]";
+  }
+  return out + "]";
+}
+
 }  // namespace
 
 std::optional<PoseVsTruth> pose_vs_truth(const SimRig& rig, const EstimationStageStats& s) {
@@ -193,8 +206,8 @@ ClassConfusion SimReport::map_confusion(const mapping::SemanticMap& map,
   const auto& params = map.params();
   // A cell is on a surface when the surface passes through it: within its half-diagonal.
   const auto tolerance = static_cast<float>(params.resolution * std::sqrt(3.0) / 2.0);
-  map.for_each_cell([&](const Eigen::Vector3f& centre, const mapping::CellPosterior& cell) {
-    if (cell.state(params.unknown_variance) != mapping::CellState::kOccupied) return;
+  map.for_each_cell([&](const Eigen::Vector3f& centre, const common::CellPosterior& cell) {
+    if (cell.state(params.unknown_variance) != common::CellState::kOccupied) return;
     confusion.add(rig_.world().class_at(centre + map_to_sim, tolerance),
                   static_cast<std::uint16_t>(cell.argmax()));
   });
@@ -318,6 +331,7 @@ std::filesystem::path SimReport::write(const RunFigures& run, const mapping::Sem
        << "  \"map_miou_surface_cells\": " << number(cells.without_free().mean_iou()) << ",\n"
        << "  \"map_cells\": {\"occupied\": " << cells.total()
        << ", \"off_surface\": " << cells.truth_count(0) << "},\n"
+       << "  \"map_confusion_truth_by_predicted\": " << confusion_rows(cells) << ",\n"
        << "  \"frames_captured\": " << run.frames_captured << ",\n"
        << "  \"frames_mapped\": " << run.frames_mapped << ",\n"
        << "  \"latency_frame_to_map_ms\": {\"p50\": "

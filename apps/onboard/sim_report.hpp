@@ -44,6 +44,8 @@ class ClassConfusion {
   double mean_iou() const;
   // Counted with true class c.
   std::uint64_t truth_count(int c) const;
+  // Counted with true class `truth` and predicted class `predicted` (K: no label).
+  std::uint64_t count(int truth, int predicted) const { return counts_[truth][predicted]; }
   std::uint64_t total() const;
   // The same without the true free cells (the semantic part of a map's errors alone).
   ClassConfusion without_free() const;

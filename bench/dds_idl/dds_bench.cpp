@@ -135,7 +135,8 @@ struct LatencySink {
   Clock::time_point first, last;
   std::vector<double> latencies_us;
   sd::BlockLimits limits;
-  std::unordered_map<sd::BlockIndex, sd::BlockSnapshot, sd::BlockIndexHash> map;
+  std::unordered_map<semap::common::BlockIndex, sd::BlockSnapshot, semap::common::BlockIndexHash>
+      map;
   sd::BlockSnapshot scratch;
 
   void operator()(std::span<const std::uint8_t> cdr, const dds_sample_info_t&) {
@@ -188,11 +189,12 @@ sd::MapDescription description(std::uint16_t cells) {
   return d;
 }
 
-sd::BlockSnapshot block(sd::BlockIndex index, std::uint16_t cells, std::uint32_t version) {
+sd::BlockSnapshot block(semap::common::BlockIndex index, std::uint16_t cells,
+                        std::uint32_t version) {
   sd::BlockSnapshot b = sd::BlockSnapshot::empty(index, 0.1f, cells, kClasses, false);
   b.version = version;
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
-    b.state[i] = static_cast<sd::CellState>(i % 3);
+    b.state[i] = static_cast<semap::common::CellState>(i % 3);
     b.argmax_class[i] = static_cast<std::uint16_t>(i % kClasses);
     b.variance[i] = 0.01f;
   }

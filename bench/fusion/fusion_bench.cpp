@@ -13,7 +13,7 @@
 
 namespace {
 
-using semap::mapping::BlockIndex;
+using semap::common::BlockIndex;
 using semap::mapping::LayeredMap;
 using semap::mapping::LayeredMapParams;
 
@@ -35,7 +35,7 @@ LayeredMap robot_map(int blocks, semap::mapping::SourceId id) {
   for (int i = 0; i < blocks; ++i) {
     semap::mapping::EvidenceGrid::Block b(layer.block_floats());
     for (float& v : b) v = static_cast<float>(count(rng));
-    layer.put_block(BlockIndex{i % side, i / side, 0}, std::move(b));
+    layer.put_block(semap::common::BlockIndex{i % side, i / side, 0}, std::move(b));
   }
   layer.set_updates(1);
   return m;
@@ -67,7 +67,7 @@ void BM_RemergeOneChangedBlock(benchmark::State& state) {
   LayeredMap fused(params());
   semap::mapping::merge_into(fused, robot, T);
   const auto& layer = *robot.find_layer(2);
-  const BlockIndex changed{3, 3, 0};
+  const semap::common::BlockIndex changed{3, 3, 0};
   for (auto _ : state) {
     const auto targets = semap::fusion::touched_blocks(changed, params(), params(), T);
     semap::fusion::remerge_blocks(fused, 2, layer, params(), targets, T);
@@ -82,7 +82,8 @@ void BM_FusedSnapshot(benchmark::State& state) {
   semap::mapping::merge_into(fused, robot_map(64, 2), Eigen::Isometry3d::Identity());
   std::uint32_t version = 0;
   for (auto _ : state) {
-    auto block = semap::fusion::fused_snapshot(fused, BlockIndex{3, 3, 0}, ++version);
+    auto block =
+        semap::fusion::fused_snapshot(fused, semap::common::BlockIndex{3, 3, 0}, ++version);
     benchmark::DoNotOptimize(block);
   }
   state.SetItemsProcessed(state.iterations());

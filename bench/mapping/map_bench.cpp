@@ -59,9 +59,9 @@ MapParams toy_params(Method method) {
 // FNV-1a over every block's index, evidence and observed bits, blocks in index order: equal
 // checksums mean bit-identical maps (threads, builds, versions).
 std::uint64_t map_checksum(const SemanticMap& map) {
-  std::vector<std::pair<semap::mapping::BlockIndex, const semap::mapping::Block*>> blocks;
+  std::vector<std::pair<semap::common::BlockIndex, const semap::mapping::Block*>> blocks;
   map.for_each_block(
-      [&](const semap::mapping::BlockIndex& index, const semap::mapping::Block& block) {
+      [&](const semap::common::BlockIndex& index, const semap::mapping::Block& block) {
         blocks.emplace_back(index, &block);
       });
   std::sort(blocks.begin(), blocks.end(), [](const auto& a, const auto& b) {

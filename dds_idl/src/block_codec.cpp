@@ -22,9 +22,10 @@ BlockMessage::BlockMessage(const BlockSnapshot& b, common::Stamp stamp, std::str
   msg_.num_classes_ = b.num_classes;
   msg_.version_ = b.version;
   // DDS only reads these during dds_write; the const_casts never lead to a write.
-  static_assert(sizeof(CellState) == sizeof(std::uint8_t));
+  static_assert(sizeof(common::CellState) == sizeof(std::uint8_t));
   msg_.state_ = borrow_sequence<dds_sequence_uint8>(
-      reinterpret_cast<std::uint8_t*>(const_cast<CellState*>(b.state.data())), b.state.size());
+      reinterpret_cast<std::uint8_t*>(const_cast<common::CellState*>(b.state.data())),
+      b.state.size());
   msg_.argmax_class_ = borrow_sequence<dds_sequence_unsigned_short>(
       const_cast<std::uint16_t*>(b.argmax_class.data()), b.argmax_class.size());
   msg_.variance_ =
@@ -91,7 +92,7 @@ BlockFields fields_of(const msg::SemanticMapBlock& m) {
 }
 
 BlockFields fields_of(const BlockSnapshot& b) {
-  static_assert(sizeof(CellState) == sizeof(std::uint8_t));
+  static_assert(sizeof(common::CellState) == sizeof(std::uint8_t));
   return {b.index.x,
           b.index.y,
           b.index.z,
@@ -146,7 +147,7 @@ bool all_finite_non_negative(const float* p, std::size_t n) {
 // Out of line: inlined into check_block, GCC 12 left these loops scalar (checked with
 // -fopt-info-vec).
 [[gnu::noinline]] bool cells_ok(const BlockFields& m, std::size_t cells) {
-  return max_of(m.state, cells) <= static_cast<std::uint8_t>(CellState::kOccupied) &&
+  return max_of(m.state, cells) <= static_cast<std::uint8_t>(common::CellState::kOccupied) &&
          max_of(m.argmax_class, cells) < m.num_classes &&
          all_finite_non_negative(m.variance, cells) &&
          all_finite_non_negative(m.evidence, m.evidence_length);
@@ -162,7 +163,7 @@ BlockCheck find_bad_cell(const BlockFields& m, std::size_t cells) {
     return reject(m, BlockReject::kNonFinite, "evidence[" + std::to_string(*i) + "]");
   }
   for (std::size_t i = 0; i < cells; ++i) {
-    if (m.state[i] > static_cast<std::uint8_t>(CellState::kOccupied)) {
+    if (m.state[i] > static_cast<std::uint8_t>(common::CellState::kOccupied)) {
       return reject(m, BlockReject::kOutOfRange, "state[" + std::to_string(i) + "]");
     }
     if (m.argmax_class[i] >= m.num_classes) {
@@ -235,7 +236,7 @@ void copy_block(const msg::SemanticMapBlock& m, BlockSnapshot& out) {
   out.block_cells = m.block_cells_;
   out.num_classes = m.num_classes_;
   out.version = m.version_;
-  // CellState is a one-byte enum and check_block accepted every code.
+  // common::CellState is a one-byte enum and check_block accepted every code.
   out.state.resize(cells);
   std::memcpy(out.state.data(), m.state_._buffer, cells);
   out.argmax_class.assign(m.argmax_class_._buffer, m.argmax_class_._buffer + cells);

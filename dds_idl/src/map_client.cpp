@@ -166,7 +166,7 @@ void MapClient::on_block(std::span<const std::uint8_t> cdr) {
   if (l.block_cells == 0) l.block_cells = scratch_.block_cells;
   if (l.resolution <= 0.0f) l.resolution = scratch_.resolution;
 
-  const BlockIndex index = scratch_.index;
+  const common::BlockIndex index = scratch_.index;
   auto [it, inserted] = blocks_.try_emplace(index);
   if (!inserted && it->second.version > scratch_.version) {
     ++counters_.stale;
@@ -177,9 +177,9 @@ void MapClient::on_block(std::span<const std::uint8_t> cdr) {
   ++counters_.accepted;
 }
 
-std::vector<BlockIndex> MapClient::take_changed() {
+std::vector<common::BlockIndex> MapClient::take_changed() {
   const std::lock_guard lock(mutex_);
-  std::vector<BlockIndex> changed(changed_.begin(), changed_.end());
+  std::vector<common::BlockIndex> changed(changed_.begin(), changed_.end());
   changed_.clear();
   return changed;
 }
@@ -188,11 +188,15 @@ CellQuery MapClient::query(const Eigen::Vector3f& p) const {
   const std::lock_guard lock(mutex_);
   const BlockLimits& l = config_.limits;
   if (l.resolution <= 0.0f || l.block_cells == 0) return {};
-  const BlockIndex index = block_of(p, l.resolution, l.block_cells);
+  // The robot's own point -> cell -> block function, so a query near a block face reads the
+  // cell the robot filled.
+  const common::MapGrid grid(l.resolution, l.block_cells);
+  const common::CellIndex cell_index = grid.cell_of(p);
+  const common::BlockIndex index = grid.block_of(cell_index);
   const auto it = blocks_.find(index);
   if (it == blocks_.end()) return {};
   const BlockSnapshot& b = it->second;
-  const std::size_t cell = cell_of(p, index, b.resolution, b.block_cells);
+  const auto cell = static_cast<std::size_t>(grid.local_index(cell_index, index));
   return {true, b.state[cell], b.argmax_class[cell], b.variance[cell]};
 }
 
@@ -200,7 +204,7 @@ void MapClient::save_pcd(const std::filesystem::path& path) const {
   const std::lock_guard lock(mutex_);
   std::size_t n = 0;
   for (const auto& [index, b] : blocks_) {
-    for (CellState s : b.state) n += s == CellState::kOccupied;
+    for (common::CellState s : b.state) n += s == common::CellState::kOccupied;
   }
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path.string());
@@ -209,7 +213,7 @@ void MapClient::save_pcd(const std::filesystem::path& path) const {
       << "WIDTH " << n << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << n << "\nDATA ascii\n";
   for (const auto& [index, b] : blocks_) {
     for (std::size_t i = 0; i < b.state.size(); ++i) {
-      if (b.state[i] != CellState::kOccupied) continue;
+      if (b.state[i] != common::CellState::kOccupied) continue;
       const Eigen::Vector3f c = b.cell_center(i);
       out << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << b.argmax_class[i] << ' '
           << b.variance[i] << '\n';

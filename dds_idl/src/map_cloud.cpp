@@ -45,7 +45,7 @@ void MapCloud::add(const Eigen::Vector3f& p, std::uint16_t cls, float variance) 
 
 void MapCloud::add_occupied(const BlockSnapshot& block) {
   for (std::size_t i = 0; i < block.state.size(); ++i) {
-    if (block.state[i] == CellState::kOccupied) {
+    if (block.state[i] == common::CellState::kOccupied) {
       add(block.cell_center(i), block.argmax_class[i], block.variance[i]);
     }
   }

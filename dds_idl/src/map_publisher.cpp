@@ -47,14 +47,14 @@ void MapPublisher::check_shape(const BlockSnapshot& block) const {
   }
 }
 
-void MapPublisher::mark_changed(const BlockIndex& index, bool inserted) {
+void MapPublisher::mark_changed(const common::BlockIndex& index, bool inserted) {
   if (inserted) info_dirty_ = true;
   changed_.insert(index);
 }
 
 void MapPublisher::update(BlockSnapshot&& block) {
   check_shape(block);
-  const BlockIndex index = block.index;
+  const common::BlockIndex index = block.index;
   const bool inserted = blocks_.insert_or_assign(index, std::move(block)).second;
   mark_changed(index, inserted);
 }

@@ -14,30 +14,30 @@ EvidenceGrid::EvidenceGrid(int block_side, int channels)
   if (channels <= 0) throw std::invalid_argument("EvidenceGrid: channels must be positive");
 }
 
-std::span<float> EvidenceGrid::cell(const CellIndex& cell) {
-  const BlockIndex key = block_of_cell(cell, block_side_);
+std::span<float> EvidenceGrid::cell(const common::CellIndex& cell) {
+  const common::BlockIndex key = common::block_of_cell(cell, block_side_);
   Block& block = blocks_[key];
   if (block.empty()) block.assign(block_floats(), 0.0f);
-  const auto offset = static_cast<std::size_t>(local_index(cell, key, block_side_)) *
+  const auto offset = static_cast<std::size_t>(common::local_index(cell, key, block_side_)) *
                       static_cast<std::size_t>(channels_);
   return {block.data() + offset, static_cast<std::size_t>(channels_)};
 }
 
-std::span<const float> EvidenceGrid::find(const CellIndex& cell) const {
-  const BlockIndex key = block_of_cell(cell, block_side_);
+std::span<const float> EvidenceGrid::find(const common::CellIndex& cell) const {
+  const common::BlockIndex key = common::block_of_cell(cell, block_side_);
   const auto it = blocks_.find(key);
   if (it == blocks_.end()) return {};
-  const auto offset = static_cast<std::size_t>(local_index(cell, key, block_side_)) *
+  const auto offset = static_cast<std::size_t>(common::local_index(cell, key, block_side_)) *
                       static_cast<std::size_t>(channels_);
   return {it->second.data() + offset, static_cast<std::size_t>(channels_)};
 }
 
-const EvidenceGrid::Block* EvidenceGrid::find_block(const BlockIndex& key) const {
+const EvidenceGrid::Block* EvidenceGrid::find_block(const common::BlockIndex& key) const {
   const auto it = blocks_.find(key);
   return it == blocks_.end() ? nullptr : &it->second;
 }
 
-void EvidenceGrid::put_block(const BlockIndex& key, Block block) {
+void EvidenceGrid::put_block(const common::BlockIndex& key, Block block) {
   if (block.size() != block_floats()) {
     throw std::invalid_argument("EvidenceGrid::put_block: block holds " +
                                 std::to_string(block.size()) + " floats, expected " +
@@ -46,7 +46,7 @@ void EvidenceGrid::put_block(const BlockIndex& key, Block block) {
   blocks_[key] = std::move(block);
 }
 
-std::optional<EvidenceGrid::Block> EvidenceGrid::take_block(const BlockIndex& key) {
+std::optional<EvidenceGrid::Block> EvidenceGrid::take_block(const common::BlockIndex& key) {
   const auto it = blocks_.find(key);
   if (it == blocks_.end()) return std::nullopt;
   Block block = std::move(it->second);

@@ -41,7 +41,7 @@ void LayeredMap::finish_fusion(std::span<float> out) const {
   }
 }
 
-bool LayeredMap::fused(const CellIndex& cell, std::span<float> out) const {
+bool LayeredMap::fused(const common::CellIndex& cell, std::span<float> out) const {
   std::fill(out.begin(), out.end(), 0.0f);
   bool known = false;
   for (const auto& [source, grid] : layers_) {
@@ -54,7 +54,7 @@ bool LayeredMap::fused(const CellIndex& cell, std::span<float> out) const {
   return known;
 }
 
-bool LayeredMap::fused_block(const BlockIndex& key, std::vector<float>& out) const {
+bool LayeredMap::fused_block(const common::BlockIndex& key, std::vector<float>& out) const {
   const auto cells =
       static_cast<std::size_t>(params_.block_side() * params_.block_side() * params_.block_side());
   out.assign(cells * static_cast<std::size_t>(params_.channels()), 0.0f);
@@ -72,8 +72,8 @@ bool LayeredMap::fused_block(const BlockIndex& key, std::vector<float>& out) con
   return any;
 }
 
-std::vector<BlockIndex> LayeredMap::block_keys() const {
-  std::unordered_set<BlockIndex, BlockKeyHash> keys;
+std::vector<common::BlockIndex> LayeredMap::block_keys() const {
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> keys;
   for (const auto& [source, grid] : layers_) {
     for (const auto& [key, block] : grid.blocks()) keys.insert(key);
   }

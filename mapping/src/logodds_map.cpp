@@ -11,12 +11,12 @@ namespace semap::mapping {
 namespace {
 
 struct CellHash {
-  std::size_t operator()(const CellIndex& c) const {
-    return BlockKeyHash{}(BlockIndex{c.x(), c.y(), c.z()});
+  std::size_t operator()(const common::CellIndex& c) const {
+    return common::BlockIndexHash{}(common::BlockIndex{c.x(), c.y(), c.z()});
   }
 };
 
-using CellSet = std::unordered_set<CellIndex, CellHash>;
+using CellSet = std::unordered_set<common::CellIndex, CellHash>;
 
 }  // namespace
 
@@ -61,12 +61,12 @@ LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
     const double range = ray.norm();
     const bool in_range = range <= p.logodds.max_range;
     const Eigen::Vector3d end = in_range ? point : origin + ray * (p.logodds.max_range / range);
-    traverse_ray(origin, end, p.resolution, [&](const CellIndex& c) { free.insert(c); });
+    traverse_ray(origin, end, p.resolution, [&](const common::CellIndex& c) { free.insert(c); });
     if (!in_range) {
       ++result.out_of_range;
       continue;
     }
-    const CellIndex cell = cell_of_point(point, p.resolution);
+    const common::CellIndex cell = p.grid().cell_of(point);
     hits.insert(cell);
     const std::span<float> labels = grid.cell(cell).subspan(1);
     if (cloud.has_probabilities()) {
@@ -75,11 +75,11 @@ LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
       model_.add_hard_label(labels, cloud.labels[i]);
     }
   }
-  for (const CellIndex& cell : hits) {
+  for (const common::CellIndex& cell : hits) {
     float& occ = grid.cell(cell)[0];
     occ = model_.clamp(occ + model_.hit());
   }
-  for (const CellIndex& cell : free) {
+  for (const common::CellIndex& cell : free) {
     if (hits.contains(cell)) continue;
     float& occ = grid.cell(cell)[0];
     occ = model_.clamp(occ + model_.miss());
@@ -90,19 +90,19 @@ LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
   return result;
 }
 
-CellSummary LogOddsMap::summary(const CellIndex& cell) const {
+CellSummary LogOddsMap::summary(const common::CellIndex& cell) const {
   std::vector<float> fused(static_cast<std::size_t>(map_.params().channels()));
   map_.fused(cell, fused);
   return summarize(map_.params(), fused);
 }
 
-std::vector<double> LogOddsMap::class_probabilities(const CellIndex& cell) const {
+std::vector<double> LogOddsMap::class_probabilities(const common::CellIndex& cell) const {
   std::vector<float> fused(static_cast<std::size_t>(map_.params().channels()));
   map_.fused(cell, fused);
   return mapping::class_probabilities(map_.params(), fused);
 }
 
-double LogOddsMap::occupancy_probability(const CellIndex& cell) const {
+double LogOddsMap::occupancy_probability(const common::CellIndex& cell) const {
   std::vector<float> fused(static_cast<std::size_t>(map_.params().channels()));
   map_.fused(cell, fused);
   return sigmoid(fused[0]);

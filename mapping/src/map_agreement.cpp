@@ -19,7 +19,7 @@ Agreement occupied_agreement(const LayeredMap& reference, const LayeredMap& cand
   Agreement a;
   std::vector<float> ref_block;
   std::vector<float> cand_block;
-  for (const BlockIndex& key : reference.block_keys()) {
+  for (const common::BlockIndex& key : reference.block_keys()) {
     reference.fused_block(key, ref_block);
     const bool cand_has = candidate.fused_block(key, cand_block);
     for (int cell = 0; cell < side * side * side; ++cell) {
@@ -35,7 +35,7 @@ Agreement occupied_agreement(const LayeredMap& reference, const LayeredMap& cand
       if (cs.label == rs.label) ++a.same_class;
     }
   }
-  for (const BlockIndex& key : candidate.block_keys()) {
+  for (const common::BlockIndex& key : candidate.block_keys()) {
     candidate.fused_block(key, cand_block);
     for (int cell = 0; cell < side * side * side; ++cell) {
       const CellSummary cs =

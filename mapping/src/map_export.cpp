@@ -27,17 +27,18 @@ void append_text(std::vector<std::uint8_t>& out, const std::string& text) {
 std::vector<OccupiedCell> occupied_cells(const LayeredMap& map) {
   const LayeredMapParams& p = map.params();
   const int side = p.block_side();
+  const common::MapGrid grid = p.grid();
   const auto channels = static_cast<std::size_t>(p.channels());
   std::vector<OccupiedCell> cells;
   std::vector<float> fused;
-  for (const BlockIndex& key : map.block_keys()) {
+  for (const common::BlockIndex& key : map.block_keys()) {
     map.fused_block(key, fused);
     for (int c = 0; c < side * side * side; ++c) {
       const CellSummary s = summarize(
           p,
           std::span<const float>(fused.data() + static_cast<std::size_t>(c) * channels, channels));
       if (!s.known || !s.occupied) continue;
-      cells.push_back({cell_centre(cell_of_local(key, c, side), p.resolution), s.label,
+      cells.push_back({grid.cell_centre(grid.cell_of_local(key, c)).cast<double>(), s.label,
                        s.probability, s.variance});
     }
   }

@@ -30,7 +30,8 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& f
   const Eigen::Isometry3d T_from_to = T_to_from.inverse();
   const int side = from_params.block_side();
   const double from_res = from_params.resolution;
-  const double to_res = to_params.resolution;
+  const common::MapGrid from_grid = from_params.grid();
+  const common::MapGrid to_grid = to_params.grid();
   const auto channels = static_cast<std::size_t>(to_params.channels());
   for (const auto& [key, block] : layer.blocks()) {
     // Bounding box of the source block in the target frame; every target cell whose centre
@@ -46,15 +47,17 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& f
       box_min = box_min.cwiseMin(p);
       box_max = box_max.cwiseMax(p);
     }
-    const CellIndex first = cell_of_point(box_min, to_res);
-    const CellIndex last = cell_of_point(box_max, to_res);
+    const common::CellIndex first = to_grid.cell_of(box_min);
+    const common::CellIndex last = to_grid.cell_of(box_max);
     for (int z = first.z(); z <= last.z(); ++z) {
       for (int y = first.y(); y <= last.y(); ++y) {
         for (int x = first.x(); x <= last.x(); ++x) {
-          const CellIndex target(x, y, z);
-          const CellIndex source = cell_of_point(T_from_to * cell_centre(target, to_res), from_res);
-          if (block_of_cell(source, side) != key) continue;
-          const auto offset = static_cast<std::size_t>(local_index(source, key, side)) * channels;
+          const common::CellIndex target(x, y, z);
+          const common::CellIndex source = from_grid.cell_of(
+              Eigen::Vector3d(T_from_to * to_grid.cell_centre(target).cast<double>()));
+          if (from_grid.block_of(source) != key) continue;
+          const auto offset =
+              static_cast<std::size_t>(from_grid.local_index(source, key)) * channels;
           const std::span<const float> values(block.data() + offset, channels);
           if (!any_nonzero(values)) continue;
           std::copy(values.begin(), values.end(), out.cell(target).begin());

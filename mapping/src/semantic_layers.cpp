@@ -53,7 +53,7 @@ MapParams semantic_params(const LayeredMapParams& params) {
 LayeredMap to_layered_map(const SemanticMap& map, SourceId robot) {
   LayeredMap out(layered_params(map.params()));
   EvidenceGrid& layer = out.layer(robot);
-  map.for_each_block([&](const BlockIndex& index, const Block& block) {
+  map.for_each_block([&](const common::BlockIndex& index, const Block& block) {
     const auto evidence = block.evidence();
     layer.put_block(index, EvidenceGrid::Block(evidence.begin(), evidence.end()));
   });

@@ -133,7 +133,9 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
   InsertResult result;
   result.training_points = training.size();
   result.hits = training.num_hits;
-  const auto block_at = [this](const BlockIndex& index) -> Block& { return this->block_at(index); };
+  const auto block_at = [this](const common::BlockIndex& index) -> Block& {
+    return this->block_at(index);
+  };
   detail::TileInsertResult fused = plan != nullptr
                                        ? inserter_->apply(*plan, training, kernel_, block_at)
                                        : inserter_->insert(training, kernel_, block_at);
@@ -146,16 +148,16 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
   return result;
 }
 
-BlockIndex SemanticMap::block_of(const Eigen::Vector3f& point) const {
+common::BlockIndex SemanticMap::block_of(const Eigen::Vector3f& point) const {
   // Through the cell index, exactly as insert() and query() do, so boundaries agree.
   const float inv_res = 1.0f / params_.resolution;
   const std::int32_t n = params_.cells_per_side();
-  return {floor_div(detail::fast_floor(point.x() * inv_res), n),
-          floor_div(detail::fast_floor(point.y() * inv_res), n),
-          floor_div(detail::fast_floor(point.z() * inv_res), n)};
+  return {common::floor_div(detail::fast_floor(point.x() * inv_res), n),
+          common::floor_div(detail::fast_floor(point.y() * inv_res), n),
+          common::floor_div(detail::fast_floor(point.z() * inv_res), n)};
 }
 
-Eigen::Vector3f SemanticMap::cell_center(const BlockIndex& block, int cell) const {
+Eigen::Vector3f SemanticMap::cell_center(const common::BlockIndex& block, int cell) const {
   const int n = params_.cells_per_side();
   const Eigen::Vector3f local(static_cast<float>(cell % n), static_cast<float>((cell / n) % n),
                               static_cast<float>(cell / (n * n)));
@@ -164,7 +166,7 @@ Eigen::Vector3f SemanticMap::cell_center(const BlockIndex& block, int cell) cons
   return (first + local + Eigen::Vector3f::Constant(0.5f)) * params_.resolution;
 }
 
-std::optional<CellPosterior> SemanticMap::query(const Eigen::Vector3f& point) const {
+std::optional<common::CellPosterior> SemanticMap::query(const Eigen::Vector3f& point) const {
   const float inv_res = 1.0f / params_.resolution;
   if (!detail::mappable(point, inv_res)) return std::nullopt;
   const std::int32_t n = params_.cells_per_side();
@@ -172,11 +174,12 @@ std::optional<CellPosterior> SemanticMap::query(const Eigen::Vector3f& point) co
       static_cast<std::int32_t>(std::floor(point.x() * inv_res)),
       static_cast<std::int32_t>(std::floor(point.y() * inv_res)),
       static_cast<std::int32_t>(std::floor(point.z() * inv_res))};
-  const BlockIndex index{floor_div(cell[0], n), floor_div(cell[1], n), floor_div(cell[2], n)};
+  const common::BlockIndex index{common::floor_div(cell[0], n), common::floor_div(cell[1], n),
+                                 common::floor_div(cell[2], n)};
   const Block* block = find_block(index);
   if (block == nullptr) return std::nullopt;
   const int c = block->cell_of(cell[0] - index.x * n, cell[1] - index.y * n, cell[2] - index.z * n);
-  return CellPosterior(block->cell_evidence(c), params_.prior, block->observed(c));
+  return common::CellPosterior(block->cell_evidence(c), params_.prior, block->observed(c));
 }
 
 int SemanticMap::label_at(const Eigen::Vector3f& point) const {
@@ -184,13 +187,13 @@ int SemanticMap::label_at(const Eigen::Vector3f& point) const {
   return cell ? cell->label(params_.unknown_variance) : -1;
 }
 
-const Block* SemanticMap::find_block(const BlockIndex& index) const {
+const Block* SemanticMap::find_block(const common::BlockIndex& index) const {
   if (!VoxelHashMap::in_range(index)) return nullptr;
   const std::uint32_t id = table_.find(index);
   return id == VoxelHashMap::kNone ? nullptr : &blocks_[id];
 }
 
-Block& SemanticMap::block_at(const BlockIndex& index) {
+Block& SemanticMap::block_at(const common::BlockIndex& index) {
   const std::uint32_t id = table_.insert(index);
   if (id == blocks_.size()) {
     indices_.push_back(index);
@@ -200,7 +203,7 @@ Block& SemanticMap::block_at(const BlockIndex& index) {
   return blocks_[id];
 }
 
-void SemanticMap::add_evidence(const BlockIndex& index, std::span<const float> evidence) {
+void SemanticMap::add_evidence(const common::BlockIndex& index, std::span<const float> evidence) {
   if (!VoxelHashMap::in_range(index)) {
     throw std::invalid_argument("block index beyond the map's +-2^20 range");
   }
@@ -219,8 +222,8 @@ MapStats SemanticMap::stats() const {
   s.scans = scans_;
   s.rejected_points = rejected_;
   // Table, index list and the deque's slots, then every block with its two heap arrays.
-  s.bytes =
-      table_.bytes() + indices_.capacity() * sizeof(BlockIndex) + blocks_.size() * sizeof(Block);
+  s.bytes = table_.bytes() + indices_.capacity() * sizeof(common::BlockIndex) +
+            blocks_.size() * sizeof(Block);
   std::size_t evidence_bytes = 0;
   for (const Block& block : blocks_) {
     s.cells += static_cast<std::size_t>(block.num_cells());

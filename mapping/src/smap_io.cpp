@@ -191,11 +191,11 @@ Header decode_header(Reader& r) {
   return h;
 }
 
-std::vector<BlockIndex> sorted_keys(const EvidenceGrid& grid) {
-  std::vector<BlockIndex> keys;
+std::vector<common::BlockIndex> sorted_keys(const EvidenceGrid& grid) {
+  std::vector<common::BlockIndex> keys;
   keys.reserve(grid.size());
   for (const auto& [key, block] : grid.blocks()) keys.push_back(key);
-  std::sort(keys.begin(), keys.end(), [](const BlockIndex& a, const BlockIndex& b) {
+  std::sort(keys.begin(), keys.end(), [](const common::BlockIndex& a, const common::BlockIndex& b) {
     return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
   });
   return keys;
@@ -214,7 +214,7 @@ std::vector<std::uint8_t> encode_smap(const LayeredMap& map) {
     w.put(grid.updates());
     w.put(static_cast<std::uint32_t>(grid.size()));
     w.put_crc_since(start);
-    for (const BlockIndex& key : sorted_keys(grid)) {
+    for (const common::BlockIndex& key : sorted_keys(grid)) {
       const auto& block = *grid.find_block(key);
       const std::size_t block_start = w.size();
       w.put(kBlockTag);
@@ -267,8 +267,8 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
         if (r.get<std::uint32_t>("block tag") != kBlockTag) {
           r.fail_at(block_start, block_where + ": bad tag");
         }
-        const BlockIndex key{r.get<std::int32_t>("block x"), r.get<std::int32_t>("block y"),
-                             r.get<std::int32_t>("block z")};
+        const common::BlockIndex key{r.get<std::int32_t>("block x"), r.get<std::int32_t>("block y"),
+                                     r.get<std::int32_t>("block z")};
         const auto count = r.get<std::uint32_t>("block value count");
         if (count != block_floats) {
           r.fail_at(block_start, block_where + ": " + std::to_string(count) + " values, expected " +

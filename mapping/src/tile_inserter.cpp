@@ -279,7 +279,7 @@ void TileInserter::group_by_tile(std::size_t count, TilePlan& plan) const {
                           for (std::int32_t ty = box.lo[1] >> ts; ty <= box.hi[1] >> ts; ++ty) {
                             for (std::int32_t tx = box.lo[0] >> ts; tx <= box.hi[0] >> ts;
                                  ++tx, ++j) {
-                              plan.pair_tiles[j] = BlockIndex{tx, ty, tz};
+                              plan.pair_tiles[j] = common::BlockIndex{tx, ty, tz};
                               plan.pair_points[j] = static_cast<std::uint32_t>(i);
                             }
                           }
@@ -333,7 +333,7 @@ bool TileInserter::number_few_tiles(std::size_t pairs, TilePlan& plan) const {
   std::array<std::uint32_t, kFewTiles> recent;
   recent.fill(kNoTile);
   for (std::size_t j = 0; j < pairs; ++j) {
-    const BlockIndex& tile = plan.pair_tiles[j];
+    const common::BlockIndex& tile = plan.pair_tiles[j];
     const std::uint32_t slot = (static_cast<std::uint32_t>(tile.x) * 0x9E3779B1u ^
                                 static_cast<std::uint32_t>(tile.y) * 0x85EBCA77u ^
                                 static_cast<std::uint32_t>(tile.z) * 0xC2B2AE3Du) >>
@@ -400,9 +400,9 @@ void TileInserter::create_blocks(TilePlan& plan, const BlockAt& block_at,
     for (std::size_t w = 0; w < mask_words_; ++w) {
       for (std::uint64_t bits = mask[w]; bits != 0; bits &= bits - 1) {
         const auto local = static_cast<std::int32_t>(w * 64) + std::countr_zero(bits);
-        const BlockIndex index{(plan.tiles[t].x << per_tile) + local % t_side,
-                               (plan.tiles[t].y << per_tile) + (local / t_side) % t_side,
-                               (plan.tiles[t].z << per_tile) + local / (t_side * t_side)};
+        const common::BlockIndex index{(plan.tiles[t].x << per_tile) + local % t_side,
+                                       (plan.tiles[t].y << per_tile) + (local / t_side) % t_side,
+                                       (plan.tiles[t].z << per_tile) + local / (t_side * t_side)};
         plan.tile_blocks.push_back({static_cast<std::uint32_t>(local), &block_at(index)});
         result.updated_blocks.push_back(index);
       }

@@ -13,8 +13,8 @@
 
 #include "fast_floor.hpp"
 #include "plane_tile.hpp"
+#include "semap/common/map_grid.hpp"
 #include "semap/mapping/block.hpp"
-#include "semap/mapping/block_index.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/semantic_map.hpp"
@@ -34,7 +34,7 @@ inline bool mappable(const Eigen::Vector3f& p, float inv_res) {
 // What one insert touched, filled by TileInserter::insert.
 struct TileInsertResult {
   std::size_t rejected_points = 0;
-  std::vector<BlockIndex> updated_blocks;
+  std::vector<common::BlockIndex> updated_blocks;
   InsertPhases phases;  // all but `training`
 };
 
@@ -59,11 +59,11 @@ struct TilePlan {
   std::vector<std::uint8_t> bad;  // 1 for rejected points
   std::size_t rejected_points = 0;
   std::vector<std::uint32_t> pair_first;  // count + 1: first (point, tile) pair of each point
-  std::vector<BlockIndex> pair_tiles;
+  std::vector<common::BlockIndex> pair_tiles;
   std::vector<std::uint32_t> pair_points;
   VoxelGrouping tile_grouping;
   std::vector<std::uint32_t> pair_tile_ids;  // per pair: its tile's number
-  std::vector<BlockIndex> tiles;
+  std::vector<common::BlockIndex> tiles;
   std::vector<std::uint32_t> tile_offsets;  // tiles.size() + 1, into tile_points
   std::vector<std::uint32_t> tile_points;
   std::vector<std::uint64_t> block_masks;  // mask_words_ per tile
@@ -87,7 +87,7 @@ struct TilePlan {
 // order). A one-block tile is written in place. Neither depends on the thread count.
 class TileInserter {
  public:
-  using BlockAt = std::function<Block&(const BlockIndex&)>;
+  using BlockAt = std::function<Block&(const common::BlockIndex&)>;
 
   explicit TileInserter(const MapParams& params);
 

@@ -13,7 +13,7 @@ TileStore::TileStore(std::filesystem::path dir, const LayeredMapParams& params, 
     : dir_(std::move(dir)), params_(params), durable_(durable) {
   std::filesystem::create_directories(dir_);
   for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
-    BlockIndex key;
+    common::BlockIndex key;
     char tail = 0;
     const std::string name = entry.path().filename().string();
     if (std::sscanf(name.c_str(), "tile_%d_%d_%d.smap%c", &key.x, &key.y, &key.z, &tail) == 3) {
@@ -22,12 +22,12 @@ TileStore::TileStore(std::filesystem::path dir, const LayeredMapParams& params, 
   }
 }
 
-std::filesystem::path TileStore::tile_path(const BlockIndex& key) const {
+std::filesystem::path TileStore::tile_path(const common::BlockIndex& key) const {
   return dir_ / ("tile_" + std::to_string(key.x) + "_" + std::to_string(key.y) + "_" +
                  std::to_string(key.z) + ".smap");
 }
 
-std::size_t TileStore::evict(LayeredMap& map, const BlockIndex& key) {
+std::size_t TileStore::evict(LayeredMap& map, const common::BlockIndex& key) {
   LayeredMap tile(map.params());
   std::size_t moved = 0;
   for (const auto& [source, layer] : map.layers()) {
@@ -47,7 +47,7 @@ std::size_t TileStore::evict(LayeredMap& map, const BlockIndex& key) {
   return moved;
 }
 
-bool TileStore::restore(LayeredMap& map, const BlockIndex& key) {
+bool TileStore::restore(LayeredMap& map, const common::BlockIndex& key) {
   if (!contains(key)) return false;
   const std::filesystem::path path = tile_path(key);
   const SmapReadResult tile = read_smap(path);

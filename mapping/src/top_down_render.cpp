@@ -5,8 +5,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "semap/common/map_grid.hpp"
 #include "semap/mapping/atomic_file.hpp"
-#include "semap/mapping/grid_index.hpp"
 #include "semap/mapping/map_export.hpp"
 
 namespace semap::mapping {
@@ -42,12 +42,13 @@ void write_top_down_pngs(const std::filesystem::path& class_png,
   // Highest occupied cell of each (x, y) column.
   Eigen::Vector2i lo(std::numeric_limits<int>::max(), std::numeric_limits<int>::max());
   Eigen::Vector2i hi(std::numeric_limits<int>::min(), std::numeric_limits<int>::min());
-  std::unordered_map<BlockIndex, Column, BlockKeyHash> columns;
+  std::unordered_map<common::BlockIndex, Column, common::BlockIndexHash> columns;
   for (const OccupiedCell& c : cells) {
-    const CellIndex cell = cell_of_point(c.centre, resolution);
+    const common::CellIndex cell =
+        common::MapGrid(static_cast<float>(resolution), 1).cell_of(c.centre);
     lo = lo.cwiseMin(cell.head<2>());
     hi = hi.cwiseMax(cell.head<2>());
-    Column& col = columns[BlockIndex{cell.x(), cell.y(), 0}];
+    Column& col = columns[common::BlockIndex{cell.x(), cell.y(), 0}];
     if (c.centre.z() > col.top) col = {c.centre.z(), c.label, c.variance};
   }
   const int s = std::max(1, options.pixels_per_cell);

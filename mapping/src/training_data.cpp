@@ -15,7 +15,7 @@ namespace semap::mapping {
 namespace {
 
 // Only called for keyable points, so the fast floor is exact.
-BlockIndex voxel_of(const Eigen::Vector3f& p, float inv_res) {
+common::BlockIndex voxel_of(const Eigen::Vector3f& p, float inv_res) {
   return {detail::fast_floor(p.x() * inv_res), detail::fast_floor(p.y() * inv_res),
           detail::fast_floor(p.z() * inv_res)};
 }
@@ -63,7 +63,7 @@ void downsample_hits(const common::LabeledCloud& cloud, const Eigen::Vector3f& o
   // Per point: 0 kept, 1 rejected, 2 beyond max_range; and its voxel. Independent per
   // point, so computed in parallel.
   std::vector<std::uint8_t> status(n);
-  std::vector<BlockIndex> keys(n);
+  std::vector<common::BlockIndex> keys(n);
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, n, kGrain),
       [&](const tbb::blocked_range<std::size_t>& range) {
@@ -144,7 +144,7 @@ void add_free_samples(const Eigen::Vector3f& origin, const MapParams& params, Tr
   for (std::size_t i = 0; i < hits; ++i) first[i + 1] += first[i];
   const std::size_t items = std::size_t{first[hits]} + 1;
   std::vector<Eigen::Vector3f> samples(items);
-  std::vector<BlockIndex> keys(items);
+  std::vector<common::BlockIndex> keys(items);
   samples[0] = origin;
   keys[0] = voxel_of(origin, inv_res);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hits, kGrain / 16),

@@ -18,7 +18,7 @@ constexpr std::size_t kChunk = 4096;
 // Below this many items one serial pass is cheaper than the sharding passes.
 constexpr std::size_t kParallelItems = 32768;
 
-std::uint8_t shard_of(const BlockIndex& v) {
+std::uint8_t shard_of(const common::BlockIndex& v) {
   const auto h = (static_cast<std::uint32_t>(v.x) * 0x9E3779B1u) ^
                  (static_cast<std::uint32_t>(v.y) * 0x85EBCA77u) ^
                  (static_cast<std::uint32_t>(v.z) * 0xC2B2AE3Du);
@@ -27,7 +27,8 @@ std::uint8_t shard_of(const BlockIndex& v) {
 
 }  // namespace
 
-void VoxelGrouping::group(std::span<const BlockIndex> keys, std::span<const std::uint8_t> skip) {
+void VoxelGrouping::group(std::span<const common::BlockIndex> keys,
+                          std::span<const std::uint8_t> skip) {
   const std::size_t n = keys.size();
   voxel_.assign(n, kNone);
   const auto skipped = [&](std::size_t i) { return !skip.empty() && skip[i] != 0; };

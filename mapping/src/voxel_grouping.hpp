@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "semap/mapping/block_index.hpp"
+#include "semap/common/map_grid.hpp"
 
 namespace semap::mapping::detail {
 
@@ -24,7 +24,7 @@ class VoxelGrouping {
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
   // Fills voxel_of() for `keys`; `skip` is empty or as long as `keys`.
-  void group(std::span<const BlockIndex> keys, std::span<const std::uint8_t> skip);
+  void group(std::span<const common::BlockIndex> keys, std::span<const std::uint8_t> skip);
 
   std::span<const std::uint32_t> voxel_of() const { return voxel_; }
   std::size_t voxels() const { return voxels_; }

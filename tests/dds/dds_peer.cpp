@@ -122,7 +122,7 @@ int bad_pub(const Options& o, const sd::Participant& p) {
   write(nan_block);
   write(sd::testing::make_block({1 << 22, 0, 0}, 1, classes, false));
   auto bad_state = sd::testing::make_block({3, 0, 0}, 1, classes, false);
-  bad_state.state[2] = static_cast<sd::CellState>(7);
+  bad_state.state[2] = static_cast<semap::common::CellState>(7);
   write(bad_state);
   auto bad_class = sd::testing::make_block({4, 0, 0}, 1, classes, false);
   bad_class.argmax_class[1] = classes;

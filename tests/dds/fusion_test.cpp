@@ -41,7 +41,7 @@ dds_idl::MapDescription description() {
 
 // Evidence robot `r` gathered about the world cell `c` (fused frame): each robot sees
 // something different, so a wrong offset or a doubled layer shows in the numbers.
-float world_evidence(int r, const mapping::CellIndex& c, std::size_t k) {
+float world_evidence(int r, const common::CellIndex& c, std::size_t k) {
   const auto h = static_cast<std::uint32_t>(c.x() * 73 + c.y() * 19 + c.z() * 7 + r * 1000 +
                                             static_cast<int>(k) * 5) *
                  2654435761u;
@@ -49,17 +49,18 @@ float world_evidence(int r, const mapping::CellIndex& c, std::size_t k) {
 }
 
 // Robot `r`'s block `key` in its own frame; its cell c is world cell c + offset.
-dds_idl::BlockSnapshot robot_block(int r, const mapping::BlockIndex& key, int offset_x,
+dds_idl::BlockSnapshot robot_block(int r, const common::BlockIndex& key, int offset_x,
                                    std::uint32_t version) {
-  auto b = dds_idl::BlockSnapshot::empty(to_dds(key), kResolution, kCells, kClasses, true);
+  auto b = dds_idl::BlockSnapshot::empty(key, kResolution, kCells, kClasses, true);
   b.version = version;
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
-    const mapping::CellIndex local = mapping::cell_of_local(key, static_cast<int>(i), kCells);
-    const mapping::CellIndex world = local + mapping::CellIndex(offset_x, 0, 0);
+    const common::CellIndex local =
+        common::MapGrid(kResolution, kCells).cell_of_local(key, static_cast<int>(i));
+    const common::CellIndex world = local + common::CellIndex(offset_x, 0, 0);
     for (std::size_t k = 0; k < kClasses; ++k) {
       b.evidence[i * kClasses + k] = world_evidence(r, world, k);
     }
-    b.state[i] = dds_idl::CellState::kOccupied;  // the fusion recomputes these
+    b.state[i] = common::CellState::kOccupied;  // the fusion recomputes these
     b.variance[i] = 0.1f;
   }
   return b;
@@ -68,7 +69,7 @@ dds_idl::BlockSnapshot robot_block(int r, const mapping::BlockIndex& key, int of
 struct Robot {
   int id;
   int offset_x;  // in cells
-  std::vector<mapping::BlockIndex> keys;
+  std::vector<common::BlockIndex> keys;
 
   std::vector<dds_idl::BlockSnapshot> blocks(std::uint32_t version) const {
     std::vector<dds_idl::BlockSnapshot> out;
@@ -78,14 +79,14 @@ struct Robot {
   mapping::LayeredMap layered(const mapping::LayeredMapParams& p) const {
     mapping::LayeredMap m(p);
     auto& layer = m.layer(static_cast<mapping::SourceId>(id));
-    for (const auto& b : blocks(1)) layer.put_block(to_mapping(b.index), evidence_block(b, p));
+    for (const auto& b : blocks(1)) layer.put_block(b.index, evidence_block(b, p));
     layer.set_updates(1);
     return m;
   }
 };
 
-std::vector<mapping::BlockIndex> block_range(int x0, int x1, int y0, int y1) {
-  std::vector<mapping::BlockIndex> keys;
+std::vector<common::BlockIndex> block_range(int x0, int x1, int y0, int y1) {
+  std::vector<common::BlockIndex> keys;
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) keys.push_back({x, y, 0});
   }
@@ -134,7 +135,7 @@ class FusionTest : public DdsTest {
     std::vector<float> alpha;
     for (const auto& key : expected_.block_keys()) {
       expected_.fused_block(key, alpha);
-      const auto& b = client.blocks().at(to_dds(key));
+      const auto& b = client.blocks().at(key);
       for (std::size_t cell = 0; cell < b.cell_count(); ++cell) {
         const std::span<const float> fused(alpha.data() + cell * kClasses, kClasses);
         for (std::size_t k = 0; k < kClasses; ++k) {
@@ -145,9 +146,9 @@ class FusionTest : public DdsTest {
           }
         }
         const auto s = mapping::summarize(params_, fused);
-        const auto state = !s.known     ? dds_idl::CellState::kUnknown
-                           : s.occupied ? dds_idl::CellState::kOccupied
-                                        : dds_idl::CellState::kFree;
+        const auto state = !s.known     ? common::CellState::kUnknown
+                           : s.occupied ? common::CellState::kOccupied
+                                        : common::CellState::kFree;
         if (b.state[cell] != state || b.argmax_class[cell] != s.label ||
             b.variance[cell] != s.variance) {
           return "state, class or variance of block " + std::to_string(key.x) + " cell " +
@@ -175,9 +176,10 @@ class FusionTest : public DdsTest {
 };
 
 std::vector<float> evidence_at(const dds_idl::MapClient& client, const Eigen::Vector3f& p) {
-  const auto index = dds_idl::block_of(p, kResolution, kCells);
+  const common::MapGrid grid(kResolution, kCells);
+  const auto index = grid.block_of(p);
   const auto& b = client.blocks().at(index);
-  const std::size_t cell = dds_idl::cell_of(p, index, kResolution, kCells);
+  const auto cell = static_cast<std::size_t>(grid.local_index(grid.cell_of(p), index));
   return {b.evidence.begin() + static_cast<std::ptrdiff_t>(cell * kClasses),
           b.evidence.begin() + static_cast<std::ptrdiff_t>((cell + 1) * kClasses)};
 }
@@ -206,7 +208,7 @@ TEST_F(FusionTest, TwoRobotsWithAKnownOffsetFuseLikeTheMappingMerge) {
 
   // In the overlap both robots' evidence adds once, on top of one prior.
   const Eigen::Vector3f overlap(3.1f, 0.3f, 0.1f);  // world cell (15, 1, 0)
-  const mapping::CellIndex c(15, 1, 0);
+  const common::CellIndex c(15, 1, 0);
   const auto e = evidence_at(fused, overlap);
   for (std::size_t k = 0; k < kClasses; ++k) {
     EXPECT_NEAR(e[k], world_evidence(1, c, k) + world_evidence(2, c, k), 1e-4) << k;
@@ -217,7 +219,7 @@ TEST_F(FusionTest, TwoRobotsWithAKnownOffsetFuseLikeTheMappingMerge) {
   const auto summary = mapping::summarize(params_, alpha);
   const dds_idl::CellQuery q = fused.query(overlap);
   EXPECT_TRUE(q.known_block);
-  EXPECT_EQ(q.state, summary.occupied ? dds_idl::CellState::kOccupied : dds_idl::CellState::kFree);
+  EXPECT_EQ(q.state, summary.occupied ? common::CellState::kOccupied : common::CellState::kFree);
   EXPECT_EQ(q.cls, summary.label);
   EXPECT_FLOAT_EQ(q.variance, summary.variance);
   // Robot2's blocks appear 10 m along x from where its own frame has them.
@@ -231,7 +233,7 @@ TEST_F(FusionTest, TwoRobotsWithAKnownOffsetFuseLikeTheMappingMerge) {
 
   // A robot resending its blocks (new version, same evidence) replaces its layer: the fused
   // evidence stays, it is not added a second time.
-  const auto overlap_block = dds_idl::block_of(overlap, kResolution, kCells);
+  const auto overlap_block = common::MapGrid(kResolution, kCells).block_of(overlap);
   const std::uint32_t version_before = fused.blocks().at(overlap_block).version;
   for (auto& b : kRobot1.blocks(2)) pub1.update(std::move(b));
   pub1.publish_changed(common::Stamp::now());
@@ -263,7 +265,7 @@ TEST_F(FusionTest, BlocksWithoutEvidenceAreCountedNotFused) {
   EXPECT_EQ(fusion.robot_counters(0).blocks, 1u);
   const auto keys = fusion.fused_map().block_keys();
   ASSERT_EQ(keys.size(), 1u);
-  EXPECT_EQ(keys[0], (mapping::BlockIndex{1, 0, 0}));
+  EXPECT_EQ(keys[0], (common::BlockIndex{1, 0, 0}));
 }
 
 }  // namespace

@@ -9,9 +9,9 @@ namespace semap::dds_idl::testing {
 
 // Deterministic block content shared by the test and its peer process, so each side can check
 // what the other sent without shipping the expectation: cell i of block b at version v.
-inline BlockSnapshot make_block(BlockIndex index, std::uint32_t version, std::uint16_t num_classes,
-                                bool with_evidence, float resolution = 0.2f,
-                                std::uint16_t block_cells = 4) {
+inline BlockSnapshot make_block(common::BlockIndex index, std::uint32_t version,
+                                std::uint16_t num_classes, bool with_evidence,
+                                float resolution = 0.2f, std::uint16_t block_cells = 4) {
   BlockSnapshot b =
       BlockSnapshot::empty(index, resolution, block_cells, num_classes, with_evidence);
   b.version = version;
@@ -19,7 +19,7 @@ inline BlockSnapshot make_block(BlockIndex index, std::uint32_t version, std::ui
       static_cast<std::uint32_t>(index.x * 31 + index.y * 17 + index.z * 7) + version * 101u;
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
     const std::uint32_t h = (seed + static_cast<std::uint32_t>(i)) * 2654435761u;
-    b.state[i] = static_cast<CellState>(h % 3);
+    b.state[i] = static_cast<common::CellState>(h % 3);
     b.argmax_class[i] = static_cast<std::uint16_t>((h >> 8) % num_classes);
     b.variance[i] = static_cast<float>((h >> 4) % 1000) * 1e-4f;
     if (with_evidence) {
@@ -38,6 +38,6 @@ inline bool same_content(const BlockSnapshot& a, const BlockSnapshot& b) {
 }
 
 // Block i of a test map: a 10 x 10 x n/100 grid around the origin.
-inline BlockIndex grid_index(int i) { return {i % 10 - 5, (i / 10) % 10 - 5, i / 100}; }
+inline common::BlockIndex grid_index(int i) { return {i % 10 - 5, (i / 10) % 10 - 5, i / 100}; }
 
 }  // namespace semap::dds_idl::testing

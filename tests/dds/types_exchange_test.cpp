@@ -96,7 +96,7 @@ TEST_F(DdsTest, PublisherAndListenerExchangeEveryType) {
   const BlockSnapshot block = make_block({0, 0, 0}, 1, 5, false);
   std::vector<CloudPoint> expected;
   for (std::size_t i = 0; i < block.cell_count(); ++i) {
-    if (block.state[i] == CellState::kOccupied) {
+    if (block.state[i] == common::CellState::kOccupied) {
       expected.push_back({block.cell_center(i), block.argmax_class[i], block.variance[i]});
     }
   }

@@ -5,8 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "semap/mapping/cell_summary.hpp"
-
 namespace semap::fusion {
 
 mapping::LayeredMapParams layered_params(const dds_idl::MapDescription& description,
@@ -41,32 +39,17 @@ mapping::EvidenceGrid::Block evidence_block(const dds_idl::BlockSnapshot& block,
 }
 
 std::optional<dds_idl::BlockSnapshot> fused_snapshot(const mapping::LayeredMap& map,
-                                                     const mapping::BlockIndex& key,
+                                                     const common::BlockIndex& key,
                                                      std::uint32_t version) {
   std::vector<float> alpha;
   if (!map.fused_block(key, alpha)) return std::nullopt;
   const mapping::LayeredMapParams& p = map.params();
-  const auto k = static_cast<std::size_t>(p.num_classes);
-  auto snap = dds_idl::BlockSnapshot::empty(to_dds(key), static_cast<float>(p.resolution),
-                                            static_cast<std::uint16_t>(p.block_side()),
-                                            static_cast<std::uint16_t>(p.num_classes), true);
-  snap.version = version;
+  // Published as increments like the robots' blocks, so a fused map can be fused again;
+  // the clamp only absorbs the rounding of (alpha_0 + e) - alpha_0.
   const auto prior = static_cast<float>(p.prior);
-  for (std::size_t cell = 0; cell < snap.cell_count(); ++cell) {
-    const std::span<const float> fused(alpha.data() + cell * k, k);
-    const mapping::CellSummary s = mapping::summarize(p, fused);
-    snap.state[cell] = !s.known     ? dds_idl::CellState::kUnknown
-                       : s.occupied ? dds_idl::CellState::kOccupied
-                                    : dds_idl::CellState::kFree;
-    snap.argmax_class[cell] = static_cast<std::uint16_t>(s.label);
-    snap.variance[cell] = s.variance;
-    // Published as increments like the robots' blocks, so a fused map can be fused again;
-    // the clamp only absorbs the rounding of (alpha_0 + e) - alpha_0.
-    for (std::size_t c = 0; c < k; ++c) {
-      snap.evidence[cell * k + c] = std::max(fused[c] - prior, 0.0f);
-    }
-  }
-  return snap;
+  for (float& a : alpha) a = std::max(a - prior, 0.0f);
+  return dds_idl::snapshot_of_evidence(key, p.grid(), p.num_classes, alpha, {}, prior, 0.0f,
+                                       version);
 }
 
 }  // namespace semap::fusion

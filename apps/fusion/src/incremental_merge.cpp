@@ -3,7 +3,7 @@
 #include <cmath>
 #include <unordered_set>
 
-#include "semap/mapping/grid_index.hpp"
+#include "semap/common/map_grid.hpp"
 #include "semap/mapping/map_merge.hpp"
 
 namespace semap::fusion {
@@ -32,12 +32,12 @@ Box transformed_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
   return box;
 }
 
-std::vector<mapping::BlockIndex> blocks_between(const mapping::CellIndex& first,
-                                                const mapping::CellIndex& last, int side) {
-  std::vector<mapping::BlockIndex> out;
+std::vector<common::BlockIndex> blocks_between(const common::CellIndex& first,
+                                               const common::CellIndex& last, int side) {
+  std::vector<common::BlockIndex> out;
   if ((last.array() < first.array()).any()) return out;
-  const mapping::BlockIndex b0 = mapping::block_of_cell(first, side);
-  const mapping::BlockIndex b1 = mapping::block_of_cell(last, side);
+  const common::BlockIndex b0 = semap::common::block_of_cell(first, side);
+  const common::BlockIndex b1 = semap::common::block_of_cell(last, side);
   for (int z = b0.z; z <= b1.z; ++z) {
     for (int y = b0.y; y <= b1.y; ++y) {
       for (int x = b0.x; x <= b1.x; ++x) out.push_back({x, y, z});
@@ -46,16 +46,16 @@ std::vector<mapping::BlockIndex> blocks_between(const mapping::CellIndex& first,
   return out;
 }
 
-Eigen::Vector3d block_origin(const mapping::BlockIndex& key, const mapping::LayeredMapParams& p) {
+Eigen::Vector3d block_origin(const common::BlockIndex& key, const mapping::LayeredMapParams& p) {
   return Eigen::Vector3d(key.x, key.y, key.z) * p.block_size();
 }
 
 }  // namespace
 
-std::vector<mapping::BlockIndex> touched_blocks(const mapping::BlockIndex& key,
-                                                const mapping::LayeredMapParams& from,
-                                                const mapping::LayeredMapParams& to,
-                                                const Eigen::Isometry3d& T_to_from) {
+std::vector<common::BlockIndex> touched_blocks(const common::BlockIndex& key,
+                                               const mapping::LayeredMapParams& from,
+                                               const mapping::LayeredMapParams& to,
+                                               const Eigen::Isometry3d& T_to_from) {
   const Eigen::Vector3d lo = block_origin(key, from);
   const Box box = transformed_box(lo, lo + Eigen::Vector3d::Constant(from.block_size()), T_to_from);
   // Target cells whose centre lies in [box.min, box.max).
@@ -69,10 +69,10 @@ std::vector<mapping::BlockIndex> touched_blocks(const mapping::BlockIndex& key,
                         {last(box.max.x()), last(box.max.y()), last(box.max.z())}, to.block_side());
 }
 
-std::vector<mapping::BlockIndex> source_blocks(const mapping::BlockIndex& key,
-                                               const mapping::LayeredMapParams& from,
-                                               const mapping::LayeredMapParams& to,
-                                               const Eigen::Isometry3d& T_to_from) {
+std::vector<common::BlockIndex> source_blocks(const common::BlockIndex& key,
+                                              const mapping::LayeredMapParams& from,
+                                              const mapping::LayeredMapParams& to,
+                                              const Eigen::Isometry3d& T_to_from) {
   // The target block's cell centres span the block shrunk by half a cell on every side.
   const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * to.resolution);
   const Eigen::Vector3d lo = block_origin(key, to) + half;
@@ -92,11 +92,11 @@ std::vector<mapping::BlockIndex> source_blocks(const mapping::BlockIndex& key,
 
 void remerge_blocks(mapping::LayeredMap& fused, mapping::SourceId source,
                     const mapping::EvidenceGrid& layer, const mapping::LayeredMapParams& from,
-                    const std::vector<mapping::BlockIndex>& targets,
+                    const std::vector<common::BlockIndex>& targets,
                     const Eigen::Isometry3d& T_to_from) {
   const mapping::LayeredMapParams& to = fused.params();
   mapping::EvidenceGrid needed(layer.block_side(), layer.channels());
-  std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> taken;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> taken;
   for (const auto& target : targets) {
     for (const auto& key : source_blocks(target, from, to, T_to_from)) {
       if (!taken.insert(key).second) continue;

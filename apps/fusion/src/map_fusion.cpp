@@ -48,11 +48,11 @@ MapFusion::MapFusion(const dds_idl::Participant& participant, MapFusionConfig co
 
 void MapFusion::take_blocks(Robot& robot) {
   robot.client->poll();
-  const std::vector<dds_idl::BlockIndex> changed = robot.client->take_changed();
+  const std::vector<common::BlockIndex> changed = robot.client->take_changed();
   if (changed.empty()) return;
   mapping::EvidenceGrid& layer = robot.layer;
   const std::size_t before = robot.changed.size();
-  for (const dds_idl::BlockIndex& index : changed) {
+  for (const common::BlockIndex& index : changed) {
     const dds_idl::BlockSnapshot& block = robot.client->blocks().at(index);
     if (!block.has_evidence()) {
       // Only argmax and variance: nothing the Dirichlet merge could add without guessing.
@@ -63,7 +63,7 @@ void MapFusion::take_blocks(Robot& robot) {
       }
       continue;
     }
-    const mapping::BlockIndex key = to_mapping(index);
+    const common::BlockIndex key = index;
     layer.put_block(key, evidence_block(block, params_));
     robot.changed.push_back(key);
     ++robot.counters.blocks;
@@ -74,10 +74,10 @@ void MapFusion::take_blocks(Robot& robot) {
 
 std::size_t MapFusion::merge_changed() {
   const auto t0 = std::chrono::steady_clock::now();
-  std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> touched;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> touched;
   for (Robot& robot : robots_) {
     if (robot.changed.empty()) continue;
-    std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> targets;
+    std::unordered_set<common::BlockIndex, common::BlockIndexHash> targets;
     for (const auto& key : robot.changed) {
       for (const auto& t : touched_blocks(key, params_, params_, robot.source.T_fused_robot)) {
         targets.insert(t);
@@ -86,7 +86,7 @@ std::size_t MapFusion::merge_changed() {
     robot.changed.clear();
     // The same as mapping::merge_into of the robot's whole layer, but resampling only the fused
     // blocks the change reaches.
-    const std::vector<mapping::BlockIndex> list(targets.begin(), targets.end());
+    const std::vector<common::BlockIndex> list(targets.begin(), targets.end());
     remerge_blocks(fused_, robot.id, robot.layer, params_, list, robot.source.T_fused_robot);
     touched.insert(list.begin(), list.end());
     ++robot.counters.merges;

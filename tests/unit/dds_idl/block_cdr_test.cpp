@@ -62,7 +62,7 @@ BlockSnapshot sample_block(bool evidence) {
   BlockSnapshot b = BlockSnapshot::empty({-3, 4, 70000}, 0.25f, 3, 5, evidence);
   b.version = 42;
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
-    b.state[i] = static_cast<CellState>(i % 3);
+    b.state[i] = static_cast<common::CellState>(i % 3);
     b.argmax_class[i] = static_cast<std::uint16_t>(i % 5);
     b.variance[i] = 0.01f * static_cast<float>(i);
   }

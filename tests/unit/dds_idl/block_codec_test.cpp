@@ -15,7 +15,7 @@ BlockSnapshot sample_block(bool evidence) {
   BlockSnapshot b = BlockSnapshot::empty({-3, 4, 0}, 0.25f, 4, 3, evidence);
   b.version = 9;
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
-    b.state[i] = static_cast<CellState>(i % 3);
+    b.state[i] = static_cast<common::CellState>(i % 3);
     b.argmax_class[i] = static_cast<std::uint16_t>(i % 3);
     b.variance[i] = 0.001f * static_cast<float>(i);
   }
@@ -77,7 +77,7 @@ TEST(BlockCodec, RejectsEachKindOfBadBlockWithItsReason) {
   EXPECT_EQ(decode_spoiled(far, small_map).reason, BlockReject::kUnknownIndex);
 
   auto state = sample_block(false);
-  state.state[0] = static_cast<CellState>(3);
+  state.state[0] = static_cast<common::CellState>(3);
   EXPECT_EQ(decode_spoiled(state).reason, BlockReject::kOutOfRange);
 
   auto cls = sample_block(false);
@@ -111,7 +111,7 @@ TEST(BlockCodec, WholeArrayChecksFindEveryBadCellAndNameTheFirst) {
   const std::size_t cells = good.cell_count();
   for (std::size_t i : {std::size_t{0}, std::size_t{17}, cells - 1}) {
     auto state = good;
-    state.state[i] = static_cast<CellState>(200);
+    state.state[i] = static_cast<common::CellState>(200);
     auto cls = good;
     cls.argmax_class[i] = 4;
     auto variance = good;
@@ -151,14 +151,16 @@ TEST(BlockCodec, CopyIntoAnExistingBlockReplacesEveryField) {
 
 TEST(BlockGeometry, PointsMapToTheCellWhoseCentreTheyAreNear) {
   const BlockSnapshot b = BlockSnapshot::empty({-2, 0, 5}, 0.2f, 4, 2, false);
+  const common::MapGrid grid = b.grid();
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
     const Eigen::Vector3f c = b.cell_center(i);
-    EXPECT_EQ(block_of(c, 0.2f, 4), b.index);
-    EXPECT_EQ(cell_of(c, b.index, 0.2f, 4), i);
+    EXPECT_EQ(grid.block_of(c), b.index);
+    EXPECT_EQ(grid.local_index(grid.cell_of(c), b.index), static_cast<int>(i));
     // Slightly off-centre stays in the same cell.
-    EXPECT_EQ(cell_of(c + Eigen::Vector3f::Constant(0.09f), b.index, 0.2f, 4), i);
+    const Eigen::Vector3f near = c + Eigen::Vector3f::Constant(0.09f);
+    EXPECT_EQ(grid.local_index(grid.cell_of(near), b.index), static_cast<int>(i));
   }
-  EXPECT_EQ(block_of(Eigen::Vector3f(-0.01f, 0.0f, 0.0f), 0.2f, 4), (BlockIndex{-1, 0, 0}));
+  EXPECT_EQ(grid.block_of(Eigen::Vector3f(-0.01f, 0.0f, 0.0f)), (common::BlockIndex{-1, 0, 0}));
 }
 
 TEST(MapCloud, ReadsBackWhatItWrote) {
@@ -168,7 +170,7 @@ TEST(MapCloud, ReadsBackWhatItWrote) {
   const auto points = read_map_cloud(cloud.message(common::Stamp(5)));
   std::size_t occupied = 0;
   for (std::size_t i = 0; i < b.cell_count(); ++i) {
-    if (b.state[i] != CellState::kOccupied) continue;
+    if (b.state[i] != common::CellState::kOccupied) continue;
     ASSERT_LT(occupied, points.size());
     EXPECT_TRUE(points[occupied].position.isApprox(b.cell_center(i)));
     EXPECT_EQ(points[occupied].cls, b.argmax_class[i]);

@@ -34,9 +34,9 @@ TEST(BlockLayers, EvidenceRoundTripsThroughALayeredMap) {
     block.evidence[i] = static_cast<float>(i % 7);
   }
   mapping::LayeredMap map(p);
-  map.layer(1).put_block(to_mapping(block.index), evidence_block(block, p));
-  map.layer(2).put_block(to_mapping(block.index), evidence_block(block, p));
-  const auto fused = fused_snapshot(map, to_mapping(block.index), 9);
+  map.layer(1).put_block(block.index, evidence_block(block, p));
+  map.layer(2).put_block(block.index, evidence_block(block, p));
+  const auto fused = fused_snapshot(map, block.index, 9);
   ASSERT_TRUE(fused);
   EXPECT_EQ(fused->version, 9u);
   EXPECT_EQ(fused->index, block.index);
@@ -48,9 +48,9 @@ TEST(BlockLayers, EvidenceRoundTripsThroughALayeredMap) {
     const auto* e = &block.evidence[cell * 3];
     const bool observed = e[0] + e[1] + e[2] > 0.0f;
     const auto best = static_cast<std::uint16_t>(std::max_element(e, e + 3) - e);
-    EXPECT_EQ(fused->state[cell], !observed   ? dds_idl::CellState::kUnknown
-                                  : best == 0 ? dds_idl::CellState::kFree
-                                              : dds_idl::CellState::kOccupied)
+    EXPECT_EQ(fused->state[cell], !observed   ? common::CellState::kUnknown
+                                  : best == 0 ? common::CellState::kFree
+                                              : common::CellState::kOccupied)
         << cell;
     if (observed) {
       EXPECT_EQ(fused->argmax_class[cell], best) << cell;

@@ -20,7 +20,7 @@ mapping::LayeredMapParams params(float resolution, std::uint16_t cells) {
   return layered_params(d, mapping::MapMethod::kBki, 0.001);
 }
 
-bool contains(const std::vector<mapping::BlockIndex>& keys, const mapping::BlockIndex& k) {
+bool contains(const std::vector<common::BlockIndex>& keys, const common::BlockIndex& k) {
   return std::find(keys.begin(), keys.end(), k) != keys.end();
 }
 
@@ -45,18 +45,18 @@ mapping::EvidenceGrid::Block random_block(std::size_t floats, std::mt19937& rng)
 TEST(IncrementalMerge, TouchedBlocksOfAnAlignedShiftAreExact) {
   const auto p = params(0.25f, 4);
   EXPECT_EQ(touched_blocks({2, -1, 3}, p, p, Eigen::Isometry3d::Identity()),
-            (std::vector<mapping::BlockIndex>{{2, -1, 3}}));
+            (std::vector<common::BlockIndex>{{2, -1, 3}}));
   EXPECT_EQ(source_blocks({2, -1, 3}, p, p, Eigen::Isometry3d::Identity()),
-            (std::vector<mapping::BlockIndex>{{2, -1, 3}}));
+            (std::vector<common::BlockIndex>{{2, -1, 3}}));
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.translation() = Eigen::Vector3d(2.0, 0.0, -1.0);  // two blocks in x, one down
-  EXPECT_EQ(touched_blocks({0, 0, 0}, p, p, T), (std::vector<mapping::BlockIndex>{{2, 0, -1}}));
-  EXPECT_EQ(source_blocks({2, 0, -1}, p, p, T), (std::vector<mapping::BlockIndex>{{0, 0, 0}}));
+  EXPECT_EQ(touched_blocks({0, 0, 0}, p, p, T), (std::vector<common::BlockIndex>{{2, 0, -1}}));
+  EXPECT_EQ(source_blocks({2, 0, -1}, p, p, T), (std::vector<common::BlockIndex>{{0, 0, 0}}));
   T.translation() = Eigen::Vector3d(0.5, 0.0, 0.0);  // half a block: two each way
   EXPECT_EQ(touched_blocks({0, 0, 0}, p, p, T),
-            (std::vector<mapping::BlockIndex>{{0, 0, 0}, {1, 0, 0}}));
+            (std::vector<common::BlockIndex>{{0, 0, 0}, {1, 0, 0}}));
   EXPECT_EQ(source_blocks({0, 0, 0}, p, p, T),
-            (std::vector<mapping::BlockIndex>{{-1, 0, 0}, {0, 0, 0}}));
+            (std::vector<common::BlockIndex>{{-1, 0, 0}, {0, 0, 0}}));
 }
 
 // Whatever the transform, every block resample_layer writes from a source block is in
@@ -66,7 +66,7 @@ TEST(IncrementalMerge, BlockRangesCoverWhatResamplingWrites) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 40; ++trial) {
     const Eigen::Isometry3d T = random_pose(rng);
-    const mapping::BlockIndex key{trial % 5 - 2, trial % 3, -1};
+    const common::BlockIndex key{trial % 5 - 2, trial % 3, -1};
     mapping::EvidenceGrid layer(p.block_side(), p.channels());
     layer.put_block(key, mapping::EvidenceGrid::Block(layer.block_floats(), 1.0f));
     const auto written = mapping::resample_layer(layer, p, p, T);
@@ -99,11 +99,11 @@ TEST(IncrementalMerge, RemergingChangedBlocksEqualsMergeIntoTheWholeLayer) {
     mapping::merge_into(fused, robot, T);
 
     // Three blocks change (one of them new, one emptied), and the incremental update runs.
-    const std::vector<mapping::BlockIndex> changed{{0, 1, 0}, {3, 0, 0}, {-2, 2, 0}};
+    const std::vector<common::BlockIndex> changed{{0, 1, 0}, {3, 0, 0}, {-2, 2, 0}};
     for (const auto& k : changed) layer.put_block(k, random_block(layer.block_floats(), rng));
     layer.put_block({-2, 2, 0}, mapping::EvidenceGrid::Block(layer.block_floats(), 0.0f));
     layer.set_updates(2);
-    std::unordered_set<mapping::BlockIndex, mapping::BlockKeyHash> targets;
+    std::unordered_set<common::BlockIndex, common::BlockIndexHash> targets;
     for (const auto& k : changed) {
       for (const auto& t : touched_blocks(k, p, p, T)) targets.insert(t);
     }

@@ -35,7 +35,7 @@ void expect_identical(const SemanticMap& a, const SemanticMap& b) {
   ASSERT_EQ(a.stats().scans, b.stats().scans);
   ASSERT_EQ(a.stats().rejected_points, b.stats().rejected_points);
   std::size_t compared = 0;
-  a.for_each_block([&](const BlockIndex& index, const Block& block) {
+  a.for_each_block([&](const common::BlockIndex& index, const Block& block) {
     const Block* other = b.find_block(index);
     ASSERT_NE(other, nullptr);
     ASSERT_EQ(std::memcmp(block.evidence().data(), other->evidence().data(),

@@ -33,7 +33,7 @@ MapParams bki_params(int k = 4) {
 using CellKey = std::tuple<int, int, int>;
 std::map<CellKey, std::vector<float>> all_cells(const SemanticMap& map) {
   std::map<CellKey, std::vector<float>> out;
-  map.for_each_block([&](const BlockIndex& index, const Block& block) {
+  map.for_each_block([&](const common::BlockIndex& index, const Block& block) {
     for (int c = 0; c < block.num_cells(); ++c) {
       const Eigen::Vector3f centre = map.cell_center(index, c);
       const CellKey key{static_cast<int>(std::floor(centre.x() / map.params().resolution)),
@@ -53,7 +53,7 @@ TEST(SemanticMap, SinglePointAddsKernelTimesYToCellsWithinEll) {
   map.insert(single_point(p, 2, 4));
   const SparseKernel kernel(params.sf2, params.ell);
   int inside = 0;
-  map.for_each_block([&](const BlockIndex& index, const Block& block) {
+  map.for_each_block([&](const common::BlockIndex& index, const Block& block) {
     for (int c = 0; c < block.num_cells(); ++c) {
       const double d = (map.cell_center(index, c) - p).cast<double>().norm();
       const auto e = block.cell_evidence(c);
@@ -163,7 +163,7 @@ TEST(SemanticMap, TwoClassCsmIsTheBinaryCountingSensorModel) {
   ASSERT_TRUE(cell.has_value());
   // Counting sensor model: p(occupied) = (hits + a0) / (hits + misses + 2 a0).
   EXPECT_FLOAT_EQ(cell->mean(1), (7.0f + 0.5f) / (10.0f + 1.0f));
-  EXPECT_EQ(cell->state(), CellState::kOccupied);
+  EXPECT_EQ(cell->state(), common::CellState::kOccupied);
 }
 
 std::vector<common::LabeledCloud> toy_scans(int count) { return testing::toy_scans(1, count); }
@@ -189,7 +189,7 @@ TEST_P(ThreadInvariance, MultiThreadedEqualsSingleThreadedBitForBit) {
   ASSERT_EQ(one.stats().blocks, two.stats().blocks);
   ASSERT_GT(one.stats().observed_cells, 1000u);
   std::size_t compared = 0;
-  one.for_each_block([&](const BlockIndex& index, const Block& a) {
+  one.for_each_block([&](const common::BlockIndex& index, const Block& a) {
     const Block* b = two.find_block(index);
     ASSERT_NE(b, nullptr);
     ASSERT_EQ(std::memcmp(a.evidence().data(), b->evidence().data(), a.evidence().size_bytes()), 0);
@@ -208,11 +208,12 @@ TEST(SemanticMap, AddingBlockEvidenceMergesMaps) {
   for (const auto& s : scans) both.insert(s, s.origin);
   first.insert(scans[0], scans[0].origin);
   second.insert(scans[1], scans[1].origin);
-  second.for_each_block(
-      [&](const BlockIndex& index, const Block& b) { first.add_evidence(index, b.evidence()); });
+  second.for_each_block([&](const common::BlockIndex& index, const Block& b) {
+    first.add_evidence(index, b.evidence());
+  });
   EXPECT_EQ(first.stats().blocks, both.stats().blocks);
   EXPECT_EQ(first.stats().observed_cells, both.stats().observed_cells);
-  both.for_each_block([&](const BlockIndex& index, const Block& b) {
+  both.for_each_block([&](const common::BlockIndex& index, const Block& b) {
     const Block* m = first.find_block(index);
     ASSERT_NE(m, nullptr);
     for (std::size_t i = 0; i < b.evidence().size(); ++i) {
@@ -334,13 +335,14 @@ TEST(SemanticMap, BadPointsAreCountedNotFatal) {
 
 TEST(SemanticMap, CellCentresLieInTheirBlock) {
   const SemanticMap map(bki_params());
-  for (const BlockIndex b : {BlockIndex{0, 0, 0}, BlockIndex{-1, 2, -3}, BlockIndex{7, -8, 0}}) {
+  for (const common::BlockIndex b :
+       {common::BlockIndex{0, 0, 0}, common::BlockIndex{-1, 2, -3}, common::BlockIndex{7, -8, 0}}) {
     for (const int cell : {0, 5, 63}) {
       EXPECT_EQ(map.block_of(map.cell_center(b, cell)), b) << cell;
     }
   }
   // Negative coordinates floor towards minus infinity.
-  EXPECT_EQ(map.block_of(Eigen::Vector3f(-0.01f, 0.39f, 0.41f)), (BlockIndex{-1, 0, 1}));
+  EXPECT_EQ(map.block_of(Eigen::Vector3f(-0.01f, 0.39f, 0.41f)), (common::BlockIndex{-1, 0, 1}));
 }
 
 TEST(SemanticMap, RejectsBadParameters) {

@@ -38,7 +38,8 @@ TEST(LogOddsMap, SingleVoxelRoadProbabilityRisesOthersFall) {
   cloud.num_classes = kClasses;
   cloud.probabilities.assign(kClasses, 0.02f / (kClasses - 1));
   cloud.probabilities[kRoad] = 0.98f;
-  const CellIndex voxel = cell_of_point(Eigen::Vector3d(1.05, 0.05, 0.05), 0.1);
+  const common::CellIndex voxel =
+      common::MapGrid(0.1f, 1).cell_of(Eigen::Vector3d(1.05, 0.05, 0.05));
 
   std::vector<double> previous = map.class_probabilities(voxel);
   for (double p : previous) EXPECT_NEAR(p, 1.0 / kClasses, 1e-6);
@@ -73,7 +74,8 @@ TEST(LogOddsMap, FirstUpdateMatchesBayesRule) {
   map.insert(cloud);
   // Two identical measurements from a uniform prior: p(c) proportional to p(c|z)^2.
   const double norm = 0.04 + 0.25 + 0.09;
-  const auto p = map.class_probabilities(cell_of_point(Eigen::Vector3d(0.55, 0.05, 0.05), 0.1));
+  const auto p =
+      map.class_probabilities(common::MapGrid(0.1f, 1).cell_of(Eigen::Vector3d(0.55, 0.05, 0.05)));
   EXPECT_NEAR(p[0], 0.04 / norm, 1e-5);
   EXPECT_NEAR(p[1], 0.25 / norm, 1e-5);
   EXPECT_NEAR(p[2], 0.09 / norm, 1e-5);
@@ -146,11 +148,11 @@ TEST(LogOddsMap, RejectsCloudWithMismatchedLabels) {
 TEST(RayTraversal, VisitsFaceConnectedCellsUpToTheEndCell) {
   const Eigen::Vector3d from(0.03, -0.17, 0.41);
   const Eigen::Vector3d to(2.71, 1.33, -0.92);
-  std::vector<CellIndex> cells;
-  traverse_ray(from, to, 0.1, [&](const CellIndex& c) { cells.push_back(c); });
+  std::vector<common::CellIndex> cells;
+  traverse_ray(from, to, 0.1, [&](const common::CellIndex& c) { cells.push_back(c); });
   ASSERT_FALSE(cells.empty());
-  EXPECT_EQ(cells.front(), cell_of_point(from, 0.1));
-  const CellIndex end = cell_of_point(to, 0.1);
+  EXPECT_EQ(cells.front(), common::MapGrid(0.1f, 1).cell_of(from));
+  const common::CellIndex end = common::MapGrid(0.1f, 1).cell_of(to);
   EXPECT_EQ((end - cells.back()).cwiseAbs().sum(), 1);
   for (std::size_t i = 1; i < cells.size(); ++i) {
     EXPECT_EQ((cells[i] - cells[i - 1]).cwiseAbs().sum(), 1) << "step " << i;
@@ -159,11 +161,11 @@ TEST(RayTraversal, VisitsFaceConnectedCellsUpToTheEndCell) {
 }
 
 TEST(RayTraversal, NegativeAxisRay) {
-  std::vector<CellIndex> cells;
+  std::vector<common::CellIndex> cells;
   traverse_ray({0.05, 0.05, 0.05}, {-0.45, 0.05, 0.05}, 0.1,
-               [&](const CellIndex& c) { cells.push_back(c); });
+               [&](const common::CellIndex& c) { cells.push_back(c); });
   ASSERT_EQ(cells.size(), 5u);
-  for (int i = 0; i < 5; ++i) EXPECT_EQ(cells[i], CellIndex(-i, 0, 0));
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(cells[i], common::CellIndex(-i, 0, 0));
 }
 
 }  // namespace

@@ -35,9 +35,9 @@ TEST(Merge, IdentityMergeAddsOccupancyAndLabelLogOdds) {
   const LogOddsModel model(a.params().logodds);
   std::size_t checked = 0;
   std::vector<float> fa(5), fb(5), fm(5);
-  for (const BlockIndex& key : b.block_keys()) {
+  for (const common::BlockIndex& key : b.block_keys()) {
     for (int c = 0; c < 64; c += 5) {
-      const CellIndex cell = cell_of_local(key, c, a.params().block_side());
+      const common::CellIndex cell = cell_of_local(key, c, a.params().block_side());
       const bool ka = a_before.fused(cell, fa);
       const bool kb = b.fused(cell, fb);
       ASSERT_EQ(a.fused(cell, fm), ka || kb);
@@ -92,7 +92,7 @@ TEST(Merge, ResamplingMovesEvidenceWithTheTransform) {
   LayeredMap b(p);
   // A single labelled cell in B's frame.
   const Eigen::Vector3d in_b(0.45, 0.15, 0.05);
-  auto cell = b.layer(2).cell(cell_of_point(in_b, p.resolution));
+  auto cell = b.layer(2).cell(p.grid().cell_of(in_b));
   cell[0] = 2.0f;
   cell[3] = 5.0f;
   b.layer(2).set_updates(1);
@@ -100,8 +100,8 @@ TEST(Merge, ResamplingMovesEvidenceWithTheTransform) {
   const Eigen::Isometry3d T_ab = rotated_translated();
   merge_into(a, b, T_ab);
   // The evidence appears where T_ab puts the cell centre, and only around there.
-  const Eigen::Vector3d centre_b = cell_centre(cell_of_point(in_b, p.resolution), p.resolution);
-  const CellIndex expected = cell_of_point(T_ab * centre_b, p.resolution);
+  const Eigen::Vector3d centre_b = p.grid().cell_centre(p.grid().cell_of(in_b)).cast<double>();
+  const common::CellIndex expected = p.grid().cell_of(Eigen::Vector3d(T_ab * centre_b));
   std::vector<float> f(5);
   ASSERT_TRUE(a.fused(expected, f));
   EXPECT_FLOAT_EQ(f[0], 2.0f);
@@ -121,7 +121,7 @@ TEST(Merge, DirichletMapsAddEvidence) {
   p.prior = 0.5;
   LayeredMap a(p);
   LayeredMap b(p);
-  const CellIndex cell(3, -1, 2);
+  const common::CellIndex cell(3, -1, 2);
   // alpha_A = (0.5, 2.5, 0.5), alpha_B = (1.5, 0.5, 3.5).
   a.layer(1).cell(cell)[1] = 2.0f;
   b.layer(2).cell(cell)[0] = 1.0f;

@@ -104,7 +104,7 @@ TEST_F(TilePagerTest, DamagedTileIsReportedWithItsFile) {
   TilePager pager(map.layers(), store, 1.0);
   pager.update(Eigen::Vector3d(100.0, 0.0, 0.0));
   ASSERT_GT(store.size(), 0u);
-  const BlockIndex key = *store.keys().begin();
+  const common::BlockIndex key = *store.keys().begin();
   std::filesystem::resize_file(store.tile_path(key), 40);
   try {
     store.restore(map.layers(), key);

@@ -120,7 +120,7 @@ TEST_F(ToySplit, MergedBkiMapEqualsSingleRobotMap) {
   merge_into(merged, to_layered_map(robot_b, 2), Eigen::Isometry3d::Identity());
   const SemanticMap fused = to_semantic_map(merged);
   std::size_t cells = 0;
-  single.for_each_cell([&](const Eigen::Vector3f& centre, const CellPosterior& expected) {
+  single.for_each_cell([&](const Eigen::Vector3f& centre, const common::CellPosterior& expected) {
     const auto got = fused.query(centre);
     ASSERT_TRUE(got.has_value());
     for (int k = 0; k < 4; ++k) {

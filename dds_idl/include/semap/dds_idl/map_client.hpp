@@ -45,7 +45,7 @@ struct MapClientCounters {
 // What the map says about one point.
 struct CellQuery {
   bool known_block = false;  // false: no block received for this place
-  CellState state = CellState::kUnknown;
+  common::CellState state = common::CellState::kUnknown;
   std::uint16_t cls = 0;
   float variance = 0.0f;
 };
@@ -57,7 +57,7 @@ struct CellQuery {
 // the map, under a lock that every member function takes (use with_blocks, not blocks()).
 class MapClient {
  public:
-  using BlockMap = std::unordered_map<BlockIndex, BlockSnapshot, BlockIndexHash>;
+  using BlockMap = std::unordered_map<common::BlockIndex, BlockSnapshot, common::BlockIndexHash>;
 
   MapClient(const Participant& participant, MapClientConfig config);
   // The receive thread holds `this`: stops it before the members go.
@@ -89,7 +89,7 @@ class MapClient {
   MapClientCounters counters() const;
   std::string last_error() const;
   // Indices of blocks accepted since the last call, each once, in no particular order.
-  std::vector<BlockIndex> take_changed();
+  std::vector<common::BlockIndex> take_changed();
 
   // Writes the occupied cells as an ASCII PCD (x y z class variance); throws on I/O errors.
   void save_pcd(const std::filesystem::path& path) const;
@@ -118,7 +118,7 @@ class MapClient {
   BlockSnapshot scratch_;
   // A set: a block changed many times between two take_changed() is listed once, and a client
   // that never asks holds at most one entry per block.
-  std::unordered_set<BlockIndex, BlockIndexHash> changed_;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
   std::optional<MapDescription> info_;
   MapClientCounters counters_;
   std::string last_error_;

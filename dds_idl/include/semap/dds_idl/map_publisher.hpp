@@ -61,7 +61,7 @@ class MapPublisher {
   void publish_info(common::Stamp now);
   void check_shape(const BlockSnapshot& block) const;
   // Marks `index` changed; `inserted`: the map grew.
-  void mark_changed(const BlockIndex& index, bool inserted);
+  void mark_changed(const common::BlockIndex& index, bool inserted);
 
   MapPublisherConfig config_;
   MapDescription description_;
@@ -72,8 +72,8 @@ class MapPublisher {
   Topic<msg::PointCloud2> cloud_topic_;
   Writer<msg::PointCloud2> cloud_writer_;
   MapCloud cloud_;
-  std::unordered_map<BlockIndex, BlockSnapshot, BlockIndexHash> blocks_;
-  std::unordered_set<BlockIndex, BlockIndexHash> changed_;
+  std::unordered_map<common::BlockIndex, BlockSnapshot, common::BlockIndexHash> blocks_;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
   bool info_dirty_ = true;
   common::Stamp next_blocks_;
   common::Stamp next_cloud_;

@@ -6,7 +6,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "semap/mapping/grid_index.hpp"
+#include "semap/common/map_grid.hpp"
 
 namespace semap::mapping {
 
@@ -16,7 +16,7 @@ namespace semap::mapping {
 class EvidenceGrid {
  public:
   using Block = std::vector<float>;
-  using BlockMap = std::unordered_map<BlockIndex, Block, BlockKeyHash>;
+  using BlockMap = std::unordered_map<common::BlockIndex, Block, common::BlockIndexHash>;
 
   EvidenceGrid(int block_side, int channels);
 
@@ -28,16 +28,16 @@ class EvidenceGrid {
   }
 
   // Channels of one cell, allocating its block (zero-filled) on first use.
-  std::span<float> cell(const CellIndex& cell);
+  std::span<float> cell(const common::CellIndex& cell);
   // Channels of one cell, or an empty span when its block does not exist.
-  std::span<const float> find(const CellIndex& cell) const;
+  std::span<const float> find(const common::CellIndex& cell) const;
 
   const BlockMap& blocks() const { return blocks_; }
-  const Block* find_block(const BlockIndex& key) const;
+  const Block* find_block(const common::BlockIndex& key) const;
   // Replaces the block at `key`; `block` must hold block_floats() values.
-  void put_block(const BlockIndex& key, Block block);
+  void put_block(const common::BlockIndex& key, Block block);
   // Removes and returns the block at `key`, if any.
-  std::optional<Block> take_block(const BlockIndex& key);
+  std::optional<Block> take_block(const common::BlockIndex& key);
   std::size_t size() const { return blocks_.size(); }
 
   // Number of scans integrated into this grid; orders two copies of one robot's evidence

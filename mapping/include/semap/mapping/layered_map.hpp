@@ -36,11 +36,11 @@ class LayeredMap {
 
   // Writes the fused channels of `cell` into `out` (channels() floats); returns false (and
   // leaves the prior in `out`) when no layer has evidence there.
-  bool fused(const CellIndex& cell, std::span<float> out) const;
+  bool fused(const common::CellIndex& cell, std::span<float> out) const;
   // Fused channels of a whole block (cells_per_block x channels); false if no layer has it.
-  bool fused_block(const BlockIndex& key, std::vector<float>& out) const;
+  bool fused_block(const common::BlockIndex& key, std::vector<float>& out) const;
   // Union of the block keys of all layers.
-  std::vector<BlockIndex> block_keys() const;
+  std::vector<common::BlockIndex> block_keys() const;
   // Blocks over all layers (what a memory budget counts).
   std::size_t resident_blocks() const;
 

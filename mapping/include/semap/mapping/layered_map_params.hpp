@@ -4,6 +4,8 @@
 #include <map>
 #include <string>
 
+#include "semap/common/map_grid.hpp"
+
 namespace semap::mapping {
 
 // How the evidence of a map is interpreted. The numeric values are stored in .smap files.
@@ -48,6 +50,7 @@ struct LayeredMapParams {
   // Same convention as SemanticMap: a block of depth d has 2^(d-1) cells per side.
   int block_side() const { return 1 << (block_depth - 1); }
   double block_size() const { return resolution * block_side(); }
+  common::MapGrid grid() const { return {static_cast<float>(resolution), block_side()}; }
 
   bool operator==(const LayeredMapParams&) const = default;
 };

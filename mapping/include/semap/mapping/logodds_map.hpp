@@ -34,12 +34,12 @@ class LogOddsMap {
   // Throws std::invalid_argument when the label arrays do not match the points.
   LogOddsInsertResult insert(const common::LabeledCloud& cloud);
 
-  CellSummary summary(const CellIndex& cell) const;
+  CellSummary summary(const common::CellIndex& cell) const;
   CellSummary summary_at(const Eigen::Vector3d& point) const {
-    return summary(cell_of_point(point, map_.params().resolution));
+    return summary(map_.params().grid().cell_of(point));
   }
-  std::vector<double> class_probabilities(const CellIndex& cell) const;
-  double occupancy_probability(const CellIndex& cell) const;
+  std::vector<double> class_probabilities(const common::CellIndex& cell) const;
+  double occupancy_probability(const common::CellIndex& cell) const;
 
   const LayeredMapParams& params() const { return map_.params(); }
   SourceId robot() const { return robot_; }

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "semap/common/config.hpp"
+#include "semap/common/map_grid.hpp"
 
 namespace semap::mapping {
 
@@ -31,6 +32,7 @@ struct MapParams {
   int cells_per_side() const { return 1 << (block_depth - 1); }
   int cells_per_block() const { return cells_per_side() * cells_per_side() * cells_per_side(); }
   float block_size() const { return resolution * static_cast<float>(cells_per_side()); }
+  common::MapGrid grid() const { return {resolution, cells_per_side()}; }
 
   // Throws std::invalid_argument naming the first bad field.
   void validate() const;

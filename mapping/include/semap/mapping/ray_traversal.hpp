@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "semap/mapping/grid_index.hpp"
+#include "semap/common/map_grid.hpp"
 
 namespace semap::mapping {
 
@@ -14,8 +14,10 @@ namespace semap::mapping {
 template <typename Visit>
 void traverse_ray(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double resolution,
                   Visit&& visit) {
-  CellIndex cell = cell_of_point(from, resolution);
-  const CellIndex end = cell_of_point(to, resolution);
+  // The map's own point -> cell function; the walk itself runs in double.
+  const common::MapGrid grid(static_cast<float>(resolution), 1);
+  common::CellIndex cell = grid.cell_of(from);
+  const common::CellIndex end = grid.cell_of(to);
   const Eigen::Vector3d dir = to - from;
   const double length = dir.norm();
   if (length <= 0.0 || cell == end) return;
@@ -42,7 +44,7 @@ void traverse_ray(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double
   // The cell count bounds the loop even when rounding makes the walk miss `end`.
   const int max_steps = (end - cell).cwiseAbs().sum() + 1;
   for (int n = 0; n < max_steps && cell != end; ++n) {
-    visit(static_cast<const CellIndex&>(cell));
+    visit(static_cast<const common::CellIndex&>(cell));
     int axis = 0;
     if (t_max[1] < t_max[axis]) axis = 1;
     if (t_max[2] < t_max[axis]) axis = 2;

@@ -8,11 +8,11 @@
 #include <span>
 #include <vector>
 
+#include "semap/common/cell_posterior.hpp"
+#include "semap/common/map_grid.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/mapping/block.hpp"
 #include "semap/mapping/block_arena.hpp"
-#include "semap/mapping/block_index.hpp"
-#include "semap/mapping/cell_posterior.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/training_data.hpp"
@@ -51,7 +51,7 @@ struct InsertResult {
   std::size_t rejected_points = 0;
   std::size_t out_of_range = 0;
   std::size_t blocks_updated = 0;
-  std::vector<BlockIndex> updated_blocks;  // the blocks this insert wrote to
+  std::vector<common::BlockIndex> updated_blocks;  // the blocks this insert wrote to
   InsertPhases phases;
 };
 
@@ -86,38 +86,39 @@ class SemanticMap {
   InsertResult insert(const TrainingSet& training);
 
   // The cell containing `point`; nullopt outside allocated blocks.
-  std::optional<CellPosterior> query(const Eigen::Vector3f& point) const;
+  std::optional<common::CellPosterior> query(const Eigen::Vector3f& point) const;
   // Class at `point`: the argmax, or -1 where the map is unknown.
   int label_at(const Eigen::Vector3f& point) const;
 
-  // Calls f(const BlockIndex&, const Block&) for every block, in no particular order.
+  // Calls f(const common::BlockIndex&, const Block&) for every block, in no particular order.
   template <typename F>
   void for_each_block(F&& f) const {
     for (std::size_t b = 0; b < blocks_.size(); ++b) f(indices_[b], blocks_[b]);
   }
-  // Calls f(const Eigen::Vector3f& centre, const CellPosterior&) for every observed cell.
+  // Calls f(const Eigen::Vector3f& centre, const common::CellPosterior&) for every observed cell.
   template <typename F>
   void for_each_cell(F&& f) const {
-    for_each_block([&](const BlockIndex& index, const Block& block) {
+    for_each_block([&](const common::BlockIndex& index, const Block& block) {
       for (int c = 0; c < block.num_cells(); ++c) {
         if (!block.observed(c)) continue;
-        f(cell_center(index, c), CellPosterior(block.cell_evidence(c), params_.prior, true));
+        f(cell_center(index, c),
+          common::CellPosterior(block.cell_evidence(c), params_.prior, true));
       }
     });
   }
 
-  const Block* find_block(const BlockIndex& index) const;
+  const Block* find_block(const common::BlockIndex& index) const;
   // Adds evidence (cells per block * K floats) to a block, creating it if needed (merging).
   // Throws std::invalid_argument for a block index beyond +-2^20 or a wrong float count.
-  void add_evidence(const BlockIndex& index, std::span<const float> evidence);
+  void add_evidence(const common::BlockIndex& index, std::span<const float> evidence);
 
-  BlockIndex block_of(const Eigen::Vector3f& point) const;
-  Eigen::Vector3f cell_center(const BlockIndex& block, int cell) const;
+  common::BlockIndex block_of(const Eigen::Vector3f& point) const;
+  Eigen::Vector3f cell_center(const common::BlockIndex& block, int cell) const;
 
   MapStats stats() const;
 
  private:
-  Block& block_at(const BlockIndex& index);
+  Block& block_at(const common::BlockIndex& index);
   // insert(training), with the map-independent part already done when `plan` is given.
   InsertResult fuse(const TrainingSet& training, detail::TilePlan* plan);
   // fuse() plus the training set's own rejected and out-of-range counts (scans given as clouds).
@@ -128,7 +129,7 @@ class SemanticMap {
   // The block table: an open-addressing map from block index to the block's position in
   // blocks_ (a deque, so Block references stay valid while blocks are added).
   VoxelHashMap table_;
-  std::vector<BlockIndex> indices_;
+  std::vector<common::BlockIndex> indices_;
   // Before blocks_: the blocks' evidence lives in it, so it must be destroyed after them.
   BlockArena arena_;
   std::deque<Block> blocks_;

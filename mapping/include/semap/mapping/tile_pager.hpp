@@ -30,7 +30,7 @@ class TilePager {
   const Stats& stats() const { return stats_; }
 
  private:
-  Eigen::Vector3d block_centre(const BlockIndex& key) const;
+  Eigen::Vector3d block_centre(const common::BlockIndex& key) const;
 
   LayeredMap& map_;
   TileStore& store_;

@@ -19,22 +19,24 @@ class TileStore {
 
   // Moves the block at `key` of every layer of `map` to disk and drops it from `map`.
   // Returns the number of layer blocks moved. A tile already on disk for `key` is replaced.
-  std::size_t evict(LayeredMap& map, const BlockIndex& key);
+  std::size_t evict(LayeredMap& map, const common::BlockIndex& key);
   // Moves the tile at `key` back into `map` (adding to any evidence `map` gained there since)
   // and deletes it from disk. Returns false when there is no such tile. Throws SmapError for a
   // damaged tile, naming its file.
-  bool restore(LayeredMap& map, const BlockIndex& key);
+  bool restore(LayeredMap& map, const common::BlockIndex& key);
 
-  bool contains(const BlockIndex& key) const { return keys_.contains(key); }
-  const std::unordered_set<BlockIndex, BlockKeyHash>& keys() const { return keys_; }
+  bool contains(const common::BlockIndex& key) const { return keys_.contains(key); }
+  const std::unordered_set<common::BlockIndex, common::BlockIndexHash>& keys() const {
+    return keys_;
+  }
   std::size_t size() const { return keys_.size(); }
-  std::filesystem::path tile_path(const BlockIndex& key) const;
+  std::filesystem::path tile_path(const common::BlockIndex& key) const;
 
  private:
   std::filesystem::path dir_;
   LayeredMapParams params_;
   bool durable_;
-  std::unordered_set<BlockIndex, BlockKeyHash> keys_;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> keys_;
 };
 
 }  // namespace semap::mapping

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "semap/mapping/block_index.hpp"
+#include "semap/common/map_grid.hpp"
 
 namespace semap::mapping {
 
@@ -19,7 +19,7 @@ class VoxelHashMap {
 
   explicit VoxelHashMap(std::size_t expected = 1024) { reset(expected); }
 
-  static bool in_range(const BlockIndex& v) {
+  static bool in_range(const common::BlockIndex& v) {
     constexpr std::int32_t kLimit = 1 << 20;
     return v.x >= -kLimit && v.x < kLimit && v.y >= -kLimit && v.y < kLimit && v.z >= -kLimit &&
            v.z < kLimit;
@@ -42,7 +42,7 @@ class VoxelHashMap {
   }
 
   // Id of `v`, inserting it with the next id when absent.
-  std::uint32_t insert(const BlockIndex& v) {
+  std::uint32_t insert(const common::BlockIndex& v) {
     if ((size_ + 1) * 2 > keys_.size()) grow();
     const std::uint64_t key = pack(v);
     std::size_t slot = mix(key) & mask_;
@@ -58,7 +58,7 @@ class VoxelHashMap {
   }
 
   // Id of `v`, or kNone.
-  std::uint32_t find(const BlockIndex& v) const {
+  std::uint32_t find(const common::BlockIndex& v) const {
     const std::uint64_t key = pack(v);
     std::size_t slot = mix(key) & mask_;
     while (keys_[slot] != kEmpty) {
@@ -71,7 +71,7 @@ class VoxelHashMap {
  private:
   // 21 bits per axis; the top bit stays clear, so kEmpty never collides with a key.
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
-  static std::uint64_t pack(const BlockIndex& v) {
+  static std::uint64_t pack(const common::BlockIndex& v) {
     constexpr std::uint64_t kMask = (std::uint64_t{1} << 21) - 1;
     return ((static_cast<std::uint64_t>(v.x) & kMask) << 42) |
            ((static_cast<std::uint64_t>(v.y) & kMask) << 21) |

@@ -20,19 +20,16 @@ namespace semap::fusion {
 mapping::LayeredMapParams layered_params(const dds_idl::MapDescription& description,
                                          mapping::MapMethod method, double prior);
 
-inline mapping::BlockIndex to_mapping(const dds_idl::BlockIndex& i) { return {i.x, i.y, i.z}; }
-inline dds_idl::BlockIndex to_dds(const mapping::BlockIndex& i) { return {i.x, i.y, i.z}; }
-
 // The block's evidence as a layer block; the block must carry evidence of `params`' shape
 // (throws std::invalid_argument otherwise).
 mapping::EvidenceGrid::Block evidence_block(const dds_idl::BlockSnapshot& block,
                                             const mapping::LayeredMapParams& params);
 
 // The fused block `key` of `map` as a DDS block: evidence alpha - alpha_0 summed over the
-// layers, state, argmax class and its variance as mapping::summarize reads them. Empty when
-// no layer holds the block.
+// layers, state, argmax class and its variance as common::CellPosterior reads them
+// (dds_idl::snapshot_of_evidence). Empty when no layer holds the block.
 std::optional<dds_idl::BlockSnapshot> fused_snapshot(const mapping::LayeredMap& map,
-                                                     const mapping::BlockIndex& key,
+                                                     const common::BlockIndex& key,
                                                      std::uint32_t version);
 
 }  // namespace semap::fusion

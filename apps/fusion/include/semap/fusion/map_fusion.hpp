@@ -5,11 +5,11 @@
 #include <unordered_map>
 #include <vector>
 
+#include "semap/common/map_grid.hpp"
 #include "semap/common/stamp.hpp"
 #include "semap/dds_idl/map_client.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/fusion/fusion_config.hpp"
-#include "semap/mapping/grid_index.hpp"
 #include "semap/mapping/layered_map.hpp"
 
 namespace semap::fusion {
@@ -57,8 +57,8 @@ class MapFusion {
     RobotSource source;
     mapping::SourceId id;
     std::unique_ptr<dds_idl::MapClient> client;
-    mapping::EvidenceGrid layer;               // the robot's evidence in its own frame
-    std::vector<mapping::BlockIndex> changed;  // since the last merge
+    mapping::EvidenceGrid layer;              // the robot's evidence in its own frame
+    std::vector<common::BlockIndex> changed;  // since the last merge
     RobotCounters counters;
   };
 
@@ -70,7 +70,7 @@ class MapFusion {
   std::vector<Robot> robots_;
   mapping::LayeredMap fused_;
   dds_idl::MapPublisher publisher_;
-  std::unordered_map<mapping::BlockIndex, std::uint32_t, mapping::BlockKeyHash> versions_;
+  std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
   common::Stamp next_merge_;
   FusionCounters counters_;
 };

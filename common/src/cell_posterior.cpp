@@ -1,6 +1,6 @@
-#include "semap/mapping/cell_posterior.hpp"
+#include "semap/common/cell_posterior.hpp"
 
-namespace semap::mapping {
+namespace semap::common {
 
 CellPosterior::CellPosterior(std::span<const float> evidence, float prior, bool observed)
     : evidence_(evidence), prior_(prior), observed_(observed) {}
@@ -46,4 +46,4 @@ int CellPosterior::label(float unknown_variance) const {
   return state(unknown_variance) == CellState::kUnknown ? -1 : argmax();
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::common

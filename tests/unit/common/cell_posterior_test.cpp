@@ -1,10 +1,10 @@
-#include "semap/mapping/cell_posterior.hpp"
+#include "semap/common/cell_posterior.hpp"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-namespace semap::mapping {
+namespace semap::common {
 namespace {
 
 TEST(CellPosterior, MeanVarianceModeMatchTheDirichletClosedForms) {
@@ -51,4 +51,4 @@ TEST(CellPosterior, VarianceThresholdTurnsUncertainCellsUnknown) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::common

@@ -4,12 +4,13 @@
 #include <optional>
 #include <span>
 
-namespace semap::mapping {
+#include "semap/common/map_grid.hpp"
 
-enum class CellState : std::uint8_t { kUnknown, kFree, kOccupied };
+namespace semap::common {
 
-// The Dirichlet posterior of one cell, alpha^k = prior + evidence^k, read in place from the
-// map's storage (valid until the map changes).
+// The Dirichlet posterior of one S-BKI / S-CSM cell, alpha^k = prior + evidence^k, read in place
+// from wherever the evidence lives (the map's blocks, a received block; valid while it does).
+// The one reader of a cell's evidence: the map, its exports and the DDS blocks all use it.
 class CellPosterior {
  public:
   CellPosterior(std::span<const float> evidence, float prior, bool observed);
@@ -39,4 +40,4 @@ class CellPosterior {
   bool observed_;
 };
 
-}  // namespace semap::mapping
+}  // namespace semap::common
