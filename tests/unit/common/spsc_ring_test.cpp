@@ -49,6 +49,28 @@ TEST(SpscRing, DropOldestKeepsNewest) {
   EXPECT_EQ(c.drops(), 6u);
 }
 
+TEST(SpscRing, DropOldestSizeAndCountersAcrossLaps) {
+  SpscRing<int> ring(4, OverflowPolicy::kDropOldest);
+  for (int i = 0; i < 11; ++i) ASSERT_TRUE(ring.try_push(i));
+  EXPECT_EQ(ring.size(), 4u);
+  int v = -1;
+  ASSERT_TRUE(ring.try_pop(v));
+  EXPECT_EQ(v, 7);
+  EXPECT_EQ(ring.size(), 3u);
+  ASSERT_TRUE(ring.try_push(11));  // fills the ring again
+  ASSERT_TRUE(ring.try_push(12));  // drops 8
+  ASSERT_TRUE(ring.try_push(13));  // drops 9
+  std::array<int, 8> out{};
+  ASSERT_EQ(ring.try_pop_batch(out), 4u);
+  EXPECT_EQ(out[0], 10);
+  EXPECT_EQ(out[3], 13);
+  EXPECT_TRUE(ring.empty());
+  const RingCounters c = ring.counters();
+  EXPECT_EQ(c.pushes, 14u);
+  EXPECT_EQ(c.pops, 5u);
+  EXPECT_EQ(c.dropped_oldest, 9u);
+}
+
 TEST(SpscRing, WrapAroundManyLaps) {
   SpscRing<std::uint64_t> ring(8);
   std::uint64_t next_in = 0;
@@ -85,6 +107,15 @@ TEST(SpscRing, MoveOnlyValuesAreMoved) {
   EXPECT_EQ(out.size(), 1000u);
 }
 
+TEST(SpscRing, RejectedValueIsNotMovedFrom) {
+  SpscRing<std::vector<int>> ring(2, OverflowPolicy::kReject);
+  ASSERT_TRUE(ring.try_push(std::vector<int>(3, 1)));
+  ASSERT_TRUE(ring.try_push(std::vector<int>(3, 2)));
+  std::vector<int> kept(5, 3);
+  EXPECT_FALSE(ring.try_push(std::move(kept)));
+  EXPECT_EQ(kept.size(), 5u);  // NOLINT(bugprone-use-after-move): a refused push keeps it
+}
+
 struct Payload {
   std::uint64_t seq = 0;
   std::array<std::uint64_t, 7> check{};  // 64 bytes in all, filled from seq
@@ -97,19 +128,29 @@ Payload make_payload(std::uint64_t seq) {
   return p;
 }
 
+// Both stress tests yield when a side finds the ring full or empty, so they also finish
+// quickly when the machine has fewer free cores than threads.
+
 // Two threads; every value must arrive exactly once, in order, and intact.
-TEST(SpscRingStress, RejectPolicyDeliversEverythingInOrder) {
+class SpscRingRejectStress : public ::testing::TestWithParam<std::size_t> {};
+
+TEST_P(SpscRingRejectStress, DeliversEverythingInOrder) {
   constexpr std::uint64_t kCount = 2'000'000;
   SpscRing<Payload> ring(1024, OverflowPolicy::kReject);
   std::thread producer([&] {
     for (std::uint64_t i = 0; i < kCount;) {
-      if (ring.try_push(make_payload(i))) ++i;
+      if (ring.try_push(make_payload(i))) {
+        ++i;
+      } else {
+        std::this_thread::yield();
+      }
     }
   });
   std::uint64_t expected = 0;
-  std::array<Payload, 32> batch{};
+  std::vector<Payload> batch(GetParam());
   while (expected < kCount) {
     const std::size_t n = ring.try_pop_batch(batch);
+    if (n == 0) std::this_thread::yield();
     for (std::size_t i = 0; i < n; ++i) {
       ASSERT_EQ(batch[i].seq, expected);
       ASSERT_EQ(batch[i].check[6], expected * 31 + 6);
@@ -120,39 +161,55 @@ TEST(SpscRingStress, RejectPolicyDeliversEverythingInOrder) {
   const RingCounters c = ring.counters();
   EXPECT_EQ(c.pops, kCount);
   EXPECT_EQ(c.pushes, kCount);
+  EXPECT_EQ(c.dropped_oldest, 0u);
+  EXPECT_TRUE(ring.empty());
 }
 
-// Under drop-oldest the consumer sees a strictly increasing subsequence, and
-// pushes = pops + dropped + what is left; nothing is duplicated or torn.
-TEST(SpscRingStress, DropOldestNeverDuplicatesOrReorders) {
+// Under drop-oldest the consumer sees a strictly increasing subsequence, intact, and
+// pushes = pops + dropped once drained; nothing is duplicated or torn.
+class SpscRingDropOldestStress : public ::testing::TestWithParam<std::size_t> {};
+
+TEST_P(SpscRingDropOldestStress, NeverDuplicatesOrReorders) {
   constexpr std::uint64_t kCount = 1'000'000;
   SpscRing<Payload> ring(64, OverflowPolicy::kDropOldest);
   std::atomic<bool> done{false};
+  // Bursts longer than the ring, so values are dropped while the consumer is popping.
   std::thread producer([&] {
-    for (std::uint64_t i = 0; i < kCount; ++i) ring.try_push(make_payload(i));
+    for (std::uint64_t i = 0; i < kCount; ++i) {
+      ring.try_push(make_payload(i));
+      if (i % 100 == 99) std::this_thread::yield();
+    }
     done.store(true, std::memory_order_release);
   });
   std::uint64_t received = 0;
   std::int64_t last = -1;
-  Payload p;
+  std::vector<Payload> batch(GetParam());
   for (;;) {
     const bool finished = done.load(std::memory_order_acquire);
-    if (ring.try_pop(p)) {
-      ASSERT_GT(static_cast<std::int64_t>(p.seq), last);
-      ASSERT_EQ(p.check[6], p.seq * 31 + 6);
-      last = static_cast<std::int64_t>(p.seq);
+    const std::size_t n = ring.try_pop_batch(batch);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_GT(static_cast<std::int64_t>(batch[i].seq), last);
+      ASSERT_EQ(batch[i].check[6], batch[i].seq * 31 + 6);
+      last = static_cast<std::int64_t>(batch[i].seq);
       ++received;
-    } else if (finished) {
-      break;
+    }
+    if (n == 0) {
+      if (finished) break;
+      std::this_thread::yield();
     }
   }
   producer.join();
   const RingCounters c = ring.counters();
   EXPECT_EQ(c.pushes + c.rejected, kCount);
   EXPECT_EQ(c.pops, received);
-  EXPECT_EQ(c.pushes, c.pops + c.dropped_oldest);
-  EXPECT_GT(c.dropped_oldest, 0u);  // a 64-slot ring cannot keep up with a free-running producer
+  EXPECT_EQ(c.pushes, received + c.dropped_oldest);
+  EXPECT_GT(c.dropped_oldest, 0u);
+  EXPECT_GT(received, 0u);
+  EXPECT_TRUE(ring.empty());
 }
+
+INSTANTIATE_TEST_SUITE_P(PopOneOrBatches, SpscRingRejectStress, ::testing::Values(1u, 32u));
+INSTANTIATE_TEST_SUITE_P(PopOneOrBatches, SpscRingDropOldestStress, ::testing::Values(1u, 32u));
 
 }  // namespace
 }  // namespace semap::common
