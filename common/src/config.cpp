@@ -77,6 +77,10 @@ bool ConfigSection::has(const std::string& key) const {
   return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
 }
 
+bool ConfigSection::is_list(const std::string& key) const {
+  return has(key) && node_[key].IsSequence();
+}
+
 YAML::Node ConfigSection::child(const std::string& key) const {
   used_->insert(key);
   const YAML::Node n = node_[key];

@@ -1,6 +1,7 @@
 #include "semap/estimation/covariance_window.hpp"
 
 #include <Eigen/Geometry>
+#include <cmath>
 
 #include "semap/estimation/so3.hpp"
 
@@ -35,19 +36,17 @@ void shear_columns(PaddedBlock9& m, const Vector3d& g, double t) {
   }
 }
 
-// Column c of y += hq h.row(c)^T over the first Rows rows and Ranks columns of h.
+// Column c of y += hq h.row(c)^T + n n.row(c)^T over the first Rows rows (and Ranks columns
+// of h).
 template <int Rows, int Ranks>
-void add_outer_column(PaddedBlock9& y, const PaddedBlock6& hq, const PaddedBlock6& h, int c) {
-  // A lazy product, so that Eigen uses FMA packets (no automatic contraction in this build).
+void add_outer_column(PaddedBlock9& y, const PaddedBlock6& hq, const PaddedBlock6& h,
+                      const GyroNoiseFactor& n, int c) {
+  // Lazy products, so that Eigen uses FMA packets.
   y.col(c).template head<Rows>().noalias() += hq.template topLeftCorner<Rows, Ranks>().lazyProduct(
       h.template block<1, Ranks>(c, 0).transpose());
+  y.col(c).template head<Rows>().noalias() +=
+      n.template topRows<Rows>().lazyProduct(n.row(c).transpose());
 }
-
-// Indices in the moment vector z = (c, e, 1, t).
-constexpr int kMomentC = 0;
-constexpr int kMomentE = 3;
-constexpr int kMomentOne = 6;
-constexpr int kMomentTime = 7;
 
 }  // namespace
 
@@ -70,11 +69,10 @@ void WorldCovariance::set(const Matrix15& p) {
 
 CovarianceWindow::CovarianceWindow(const ImuNoise& noise, const Vector3d& gravity)
     : gravity_(gravity),
-      qg_(noise.gyro_noise * noise.gyro_noise),
-      qa_(noise.accel_noise * noise.accel_noise),
+      gyro_sigma_(noise.gyro_noise),
+      accel_sigma_(noise.accel_noise),
       qp_(noise.position_process * noise.position_process) {
-  qb_.head<3>().setConstant(noise.gyro_bias_walk * noise.gyro_bias_walk);
-  qb_.tail<3>().setConstant(noise.accel_bias_walk * noise.accel_bias_walk);
+  qb_ << noise.gyro_bias_walk.cwiseAbs2(), noise.accel_bias_walk.cwiseAbs2();
 }
 
 void CovarianceWindow::clear() {
@@ -83,28 +81,38 @@ void CovarianceWindow::clear() {
   h_.setZero();
   kq_.setZero();
   y_.setZero();
-  moments_.setZero();
+  accel_sums_.setZero();
 }
 
-void CovarianceWindow::add(const InekfImuStep& step) {
+void CovarianceWindow::add(const InekfImuStep& step, const Matrix3d& r) {
   const double dt = step.dt;
-  if (steps_ > 0) {  // H_0 = 0: the first step adds nothing to K and Y
-    // Y += H Qb H^T dt on the upper block triangle (mirrored in apply): columns of block b
-    // take rows 0..3b+2 rounded up to whole packets. Rotation rows have no accel-bias part.
-    const Eigen::Matrix<double, 6, 1> weights = qb_ * dt;
-    const PaddedBlock6 hq = h_ * weights.asDiagonal();
-    kq_ += hq;
-    for (int c = kRot; c < kRot + 3; ++c) add_outer_column<4, 3>(y_, hq, h_, c);
-    for (int c = kVel; c < kVel + 3; ++c) add_outer_column<8, 6>(y_, hq, h_, c);
-    for (int c = kPos; c < kPos + 3; ++c) add_outer_column<kPaddedRows, 6>(y_, hq, h_, c);
+  const double root_dt = std::sqrt(dt);
+  // The gyro columns of N_k, padded like H.
+  const Matrix3d rg = r * (root_dt * gyro_sigma_).asDiagonal();
+  GyroNoiseFactor n;
+  n.block<3, 3>(kRot, 0) = rg;
+  for (int j = 0; j < 3; ++j) {
+    n.block<3, 1>(kVel, j) = step.c.cross(rg.col(j));
+    n.block<3, 1>(kPos, j) = step.e.cross(rg.col(j));
   }
+  n.bottomRows<kPaddedRows - 9>().setZero();
+  // Its accel columns [0; Ra; -t_k Ra] only need the sums of Sa, t_k Sa and t_k^2 Sa,
+  // Sa = Ra Ra^T (3x3 each, instead of a rank-3 update of the velocity and position columns).
+  const Matrix3d ra = r * (root_dt * accel_sigma_).asDiagonal();
+  Matrix3d sa;
+  sa.noalias() = ra * ra.transpose();
+  accel_sums_.leftCols<3>() += sa;
+  accel_sums_.middleCols<3>(3) += step.t0 * sa;
+  accel_sums_.rightCols<3>() += (step.t0 * step.t0) * sa;
+  // Y += H Qb H^T dt + N N^T on the upper block triangle (mirrored in apply): columns of block
+  // b take rows 0..3b+2 rounded up to whole packets. Rotation rows have no accel-bias part.
+  const Eigen::Matrix<double, 6, 1> weights = qb_ * dt;
+  const PaddedBlock6 hq = h_ * weights.asDiagonal();
+  kq_ += hq;
+  for (int c = kRot; c < kRot + 3; ++c) add_outer_column<4, 3>(y_, hq, h_, n, c);
+  for (int c = kVel; c < kVel + 3; ++c) add_outer_column<8, 6>(y_, hq, h_, n, c);
+  for (int c = kPos; c < kPos + 3; ++c) add_outer_column<kPaddedRows, 6>(y_, hq, h_, n, c);
   h_ += step.coupling;
-  Eigen::Matrix<double, 8, 1> z;
-  z.segment<3>(kMomentC) = step.c;
-  z.segment<3>(kMomentE) = step.e;
-  z(kMomentOne) = 1.0;
-  z(kMomentTime) = step.t0;
-  moments_.noalias() += (dt * z) * z.transpose();
   elapsed_ += dt;
   ++steps_;
 }
@@ -130,58 +138,16 @@ void CovarianceWindow::apply(WorldCovariance& p) const {
     for (int r = 4; r < 9; ++r) p.a(r, c) += y_(c, r);
   }
   for (int c = kVel; c < kVel + 3; ++c) p.a(8, c) += y_(c, 8);
+  // The accel columns of N N^T, [0, 0, 0; 0, Sa, -t_k Sa; 0, -t_k Sa, t_k^2 Sa], summed.
+  p.a.block<3, 3>(kVel, kVel) += accel_sums_.leftCols<3>();
+  p.a.block<3, 3>(kPos, kVel) -= accel_sums_.middleCols<3>(3);
+  p.a.block<3, 3>(kVel, kPos) -= accel_sums_.middleCols<3>(3);
+  p.a.block<3, 3>(kPos, kPos) += accel_sums_.rightCols<3>();
   shear_rows(p.a, gravity_, t);
   shear_columns(p.a, gravity_, t);
-  add_white_noise(p.a);
+  // The position noise, isotropic and on the position block only, is left alone by F.
+  p.a.block<3, 3>(kPos, kPos).diagonal().array() += qp_ * t;
   p.c = c_end;
-}
-
-void CovarianceWindow::add_white_noise(PaddedBlock9& a) const {
-  // a_k = c_k + g T and b_k = e_k + c_k T + g h (h = T^2 / 2): their dt-weighted sums and
-  // second moments expand into the moments of (c, e, 1).
-  const double t = elapsed_;
-  const double h = 0.5 * t * t;
-  const Vector3d& g = gravity_;
-  const auto m_cc = moments_.block<3, 3>(kMomentC, kMomentC);
-  const auto m_ce = moments_.block<3, 3>(kMomentC, kMomentE);  // sum dt c e^T
-  const auto m_ee = moments_.block<3, 3>(kMomentE, kMomentE);
-  const Vector3d m_c = moments_.block<3, 1>(kMomentC, kMomentOne);
-  const Vector3d m_e = moments_.block<3, 1>(kMomentE, kMomentOne);
-  const double s0 = moments_(kMomentOne, kMomentOne);    // sum dt
-  const double s1 = moments_(kMomentOne, kMomentTime);   // sum t_k dt
-  const double s2 = moments_(kMomentTime, kMomentTime);  // sum t_k^2 dt
-  const Matrix3d gg = s0 * g * g.transpose();
-  const Matrix3d cg = m_c * g.transpose();
-  const Matrix3d eg = m_e * g.transpose();
-  const Matrix3d cg_sym = cg + cg.transpose();
-  const Vector3d sum_a = m_c + (t * s0) * g;
-  const Vector3d sum_b = m_e + t * m_c + (h * s0) * g;
-  const Matrix3d saa = m_cc + t * cg_sym + (t * t) * gg;
-  const Matrix3d sab = m_ce + t * m_cc + h * cg + t * eg.transpose() + (t * t) * cg.transpose() +
-                       (t * h) * gg;  // sum dt a b^T
-  const Matrix3d sbb = m_ee + t * (m_ce + m_ce.transpose()) + (t * t) * m_cc +
-                       h * (eg + eg.transpose()) + (t * h) * cg_sym + (h * h) * gg;
-  const double tau1 = t * s0 - s1;                     // sum tau_k dt
-  const double tau2 = t * t * s0 - 2.0 * t * s1 + s2;  // sum tau_k^2 dt
-  // Gyro noise qg [I; [a]x; [b]x][...]^T with [b]x [a]x^T = (a.b) I - a b^T; accel noise
-  // qa [0; I; tau I][...]^T; position noise qp on the position block.
-  const Matrix3d ax = qg_ * skew(sum_a);
-  const Matrix3d bx = qg_ * skew(sum_b);
-  a.block<3, 3>(kRot, kRot).diagonal().array() += qg_ * s0;
-  a.block<3, 3>(kVel, kRot) += ax;
-  a.block<3, 3>(kRot, kVel) -= ax;
-  a.block<3, 3>(kPos, kRot) += bx;
-  a.block<3, 3>(kRot, kPos) -= bx;
-  Matrix3d vv = -qg_ * saa;
-  vv.diagonal().array() += qg_ * saa.trace() + qa_ * s0;
-  a.block<3, 3>(kVel, kVel) += vv;
-  Matrix3d pv = -qg_ * sab;
-  pv.diagonal().array() += qg_ * sab.trace() + qa_ * tau1;
-  a.block<3, 3>(kPos, kVel) += pv;
-  a.block<3, 3>(kVel, kPos) += pv.transpose();
-  Matrix3d pp = -qg_ * sbb;
-  pp.diagonal().array() += qg_ * sbb.trace() + qa_ * tau2 + qp_ * s0;
-  a.block<3, 3>(kPos, kPos) += pp;
 }
 
 }  // namespace semap::estimation

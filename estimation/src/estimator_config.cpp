@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <sstream>
+#include <string>
 
 namespace semap::estimation {
 
@@ -15,6 +17,23 @@ Eigen::Vector3d vector3(const common::ConfigSection& s, const std::string& key,
   if (v.size() != 3) throw common::ConfigError(s.file() + ": " + key + " needs 3 values");
   return {v[0], v[1], v[2]};
 }
+
+// A per-axis noise density in [0, hi]: [x, y, z], or one value for all three axes.
+Eigen::Vector3d per_axis(const common::ConfigSection& s, const std::string& key,
+                         const Eigen::Vector3d& fallback, double hi) {
+  if (!s.has(key)) return fallback;
+  if (!s.is_list(key)) return Eigen::Vector3d::Constant(s.get_in_range(key, 0.0, 0.0, hi));
+  const Eigen::Vector3d v = vector3(s, key, fallback);
+  for (int i = 0; i < 3; ++i) {
+    if (!(v[i] >= 0.0 && v[i] <= hi)) {
+      std::ostringstream what;
+      what << "value " << v[i] << " out of range [0, " << hi << "]";
+      s.reject(key, static_cast<std::size_t>(i), what.str());
+    }
+  }
+  return v;
+}
+
 }  // namespace
 
 EstimatorConfig load_estimator_config(const common::ConfigSection& s) {
@@ -23,10 +42,10 @@ EstimatorConfig load_estimator_config(const common::ConfigSection& s) {
                  ? FilterKind::kQuaternionEskf
                  : FilterKind::kLeftInekf;
   auto& n = c.params.noise;
-  n.gyro_noise = s.get_in_range("gyro_noise", n.gyro_noise, 0.0, 1.0);
-  n.accel_noise = s.get_in_range("accel_noise", n.accel_noise, 0.0, 10.0);
-  n.gyro_bias_walk = s.get_in_range("gyro_bias_walk", n.gyro_bias_walk, 0.0, 1.0);
-  n.accel_bias_walk = s.get_in_range("accel_bias_walk", n.accel_bias_walk, 0.0, 10.0);
+  n.gyro_noise = per_axis(s, "gyro_noise", n.gyro_noise, 1.0);
+  n.accel_noise = per_axis(s, "accel_noise", n.accel_noise, 10.0);
+  n.gyro_bias_walk = per_axis(s, "gyro_bias_walk", n.gyro_bias_walk, 1.0);
+  n.accel_bias_walk = per_axis(s, "accel_bias_walk", n.accel_bias_walk, 10.0);
   c.params.gravity.z() = -s.get_in_range("gravity", -c.params.gravity.z(), 9.7, 9.9);
   c.gating_probability = s.get_in_range("gating_probability", c.gating_probability, 0.5, 0.999999);
   c.lever_arm = vector3(s, "lever_arm", c.lever_arm);

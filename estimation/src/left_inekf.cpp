@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 
+#include "semap/estimation/inekf_propagation.hpp"
 #include "semap/estimation/kalman_update.hpp"
 #include "semap/estimation/so3.hpp"
 
@@ -35,16 +36,6 @@ void apply_adjoint(M& m, const Matrix3d& e, const Vector3d& dv, const Vector3d& 
 }
 
 }  // namespace
-
-Eigen::Matrix<double, 15, 1> process_noise_diagonal(const ImuNoise& noise) {
-  Eigen::Matrix<double, 15, 1> q;
-  q.segment<3>(kRot).setConstant(noise.gyro_noise * noise.gyro_noise);
-  q.segment<3>(kVel).setConstant(noise.accel_noise * noise.accel_noise);
-  q.segment<3>(kPos).setConstant(noise.position_process * noise.position_process);
-  q.segment<3>(kGyroBias).setConstant(noise.gyro_bias_walk * noise.gyro_bias_walk);
-  q.segment<3>(kAccelBias).setConstant(noise.accel_bias_walk * noise.accel_bias_walk);
-  return q;
-}
 
 LeftInekf::LeftInekf(const FilterParams& params, int max_window_steps)
     : params_(params),
@@ -93,11 +84,16 @@ void LeftInekf::propagate(const Vector3d& gyro, const Vector3d& accel, double dt
   const Vector3d w = gyro - bg_;
   const Vector3d a = accel - ba_;
   const Vector3d& g = params_.gravity;
-  // P- = Phi (P + Q dt) Phi^T, deferred: the window keeps what P at its end needs.
   const InekfImuStep step =
       InekfImuStep::compute(r_, v_, p_pos_ - origin_, w, a, dt, g, window_.elapsed());
-  window_.add(step);
-  cache_valid_ = false;
+  // P- = Phi (P + Q dt) Phi^T: at once in one-step mode, else deferred, the window keeping
+  // what P at its end needs.
+  if (max_window_steps_ == 1) {
+    p_.set(propagate_world_covariance(p_.dense(), relative_state(), step, params_));
+  } else {
+    window_.add(step, r_);
+    cache_valid_ = false;
+  }
 
   p_pos_ += v_ * dt + step.dp + (0.5 * dt * dt) * g;
   v_ += step.dv + dt * g;

@@ -1,7 +1,6 @@
 #include "semap/estimation/quaternion_eskf.hpp"
 
 #include "semap/estimation/kalman_update.hpp"
-#include "semap/estimation/left_inekf.hpp"
 #include "semap/estimation/so3.hpp"
 
 namespace semap::estimation {
@@ -14,7 +13,11 @@ Eigen::Quaterniond quaternion_exp(const Vector3d& phi) { return Eigen::Quaternio
 }  // namespace
 
 QuaternionEskf::QuaternionEskf(const FilterParams& params)
-    : params_(params), q_diag_(process_noise_diagonal(params.noise)) {}
+    : params_(params),
+      q_diag_(process_noise_diagonal(params.noise)),
+      accel_q_(q_diag_.segment<3>(kVel)) {
+  q_diag_.segment<3>(kVel).setZero();
+}
 
 void QuaternionEskf::reset(const NavState& state, const Matrix15& world_covariance) {
   q_ = Eigen::Quaterniond(state.rotation).normalized();
@@ -42,6 +45,8 @@ void QuaternionEskf::propagate(const Vector3d& gyro, const Vector3d& accel, doub
   f.block<3, 3>(kPos, kVel) = dt * Matrix3d::Identity();
   p_ = f * p_ * f.transpose();
   p_.diagonal() += q_diag_ * dt;
+  // The velocity error is world-frame: the body-frame accel noise enters as R Qa R^T.
+  p_.block<3, 3>(kVel, kVel).noalias() += r * (dt * accel_q_).asDiagonal() * r.transpose();
   p_ = 0.5 * (p_ + p_.transpose()).eval();
 
   const Vector3d acc_world = r * a + params_.gravity;

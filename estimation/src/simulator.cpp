@@ -141,8 +141,8 @@ SimulationData simulate(const SimulatorConfig& c) {
   const auto steps = static_cast<std::size_t>(std::floor(c.duration_s * c.imu_rate_hz));
   const double t0 = 1.0;  // stamps start at 1 s, keeping 0 free as "unset"
   const auto& n = c.imu_noise;
-  const double gyro_sd = n.gyro_noise * std::sqrt(c.imu_rate_hz);
-  const double accel_sd = n.accel_noise * std::sqrt(c.imu_rate_hz);
+  const Vector3d gyro_sd = n.gyro_noise * std::sqrt(c.imu_rate_hz);
+  const Vector3d accel_sd = n.accel_noise * std::sqrt(c.imu_rate_hz);
   Vector3d bg = c.initial_gyro_bias_sigma * gaussian3();
   Vector3d ba = c.initial_accel_bias_sigma * gaussian3();
 
@@ -196,8 +196,8 @@ SimulationData simulate(const SimulatorConfig& c) {
         if (j == kSubsteps / 2 - 1) mid = motion_at(profile, k, t, c.gravity);
       }
       // Biases walk over the interval; the sample carries the end-of-interval bias.
-      bg += n.gyro_bias_walk * std::sqrt(dt) * gaussian3();
-      ba += n.accel_bias_walk * std::sqrt(dt) * gaussian3();
+      bg += (std::sqrt(dt) * n.gyro_bias_walk).cwiseProduct(gaussian3());
+      ba += (std::sqrt(dt) * n.accel_bias_walk).cwiseProduct(gaussian3());
     } else {
       mid = motion_at(profile, k, t, c.gravity);
     }
@@ -212,8 +212,8 @@ SimulationData simulate(const SimulatorConfig& c) {
     common::ImuSample imu;
     imu.stamp = truth.stamp;
     imu.sequence = static_cast<std::uint32_t>(i);
-    imu.gyro = mid.gyro + bg + gyro_sd * gaussian3();
-    imu.accel = mid.specific_force + ba + accel_sd * gaussian3();
+    imu.gyro = mid.gyro + bg + gyro_sd.cwiseProduct(gaussian3());
+    imu.accel = mid.specific_force + ba + accel_sd.cwiseProduct(gaussian3());
     out.imu.push_back(imu);
   }
   return out;

@@ -284,5 +284,23 @@ TEST(EstimatorConfig, LoadsAndRejectsUnknownKeys) {
   EXPECT_THROW(load_estimator_config(range), common::ConfigError);
 }
 
+// IMU noise keys take one value for all axes (as before) or one per body axis.
+TEST(EstimatorConfig, NoiseIsScalarOrPerAxis) {
+  const auto mixed = common::ConfigSection::load_string(
+      "gyro_noise: 2.0e-4\naccel_noise: [1.0e-3, 2.0e-3, 4.0e-3]\ngyro_bias_walk: [1e-5, 2e-5, "
+      "3e-5]\n");
+  const EstimatorConfig c = load_estimator_config(mixed);
+  EXPECT_EQ(c.params.noise.gyro_noise, Eigen::Vector3d::Constant(2.0e-4));
+  EXPECT_EQ(c.params.noise.accel_noise, Eigen::Vector3d(1.0e-3, 2.0e-3, 4.0e-3));
+  EXPECT_EQ(c.params.noise.gyro_bias_walk, Eigen::Vector3d(1e-5, 2e-5, 3e-5));
+  EXPECT_EQ(c.params.noise.accel_bias_walk, ImuNoise{}.accel_bias_walk);  // default kept
+  const auto too_large = common::ConfigSection::load_string("gyro_bias_walk: [1e-5, 2, 1e-5]\n");
+  EXPECT_THROW(load_estimator_config(too_large), common::ConfigError);
+  const auto two = common::ConfigSection::load_string("accel_noise: [1e-3, 1e-3]\n");
+  EXPECT_THROW(load_estimator_config(two), common::ConfigError);
+  const auto negative = common::ConfigSection::load_string("gyro_noise: -1e-4\n");
+  EXPECT_THROW(load_estimator_config(negative), common::ConfigError);
+}
+
 }  // namespace
 }  // namespace semap::estimation

@@ -14,7 +14,11 @@ SimulatorConfig noiseless(Scenario scenario) {
   SimulatorConfig c;
   c.scenario = scenario;
   c.duration_s = 60.0;
-  c.imu_noise = ImuNoise{0, 0, 0, 0, 0};
+  c.imu_noise.gyro_noise.setZero();
+  c.imu_noise.accel_noise.setZero();
+  c.imu_noise.gyro_bias_walk.setZero();
+  c.imu_noise.accel_bias_walk.setZero();
+  c.imu_noise.position_process = 0.0;
   c.initial_gyro_bias_sigma = 0.0;
   c.initial_accel_bias_sigma = 0.0;
   return c;

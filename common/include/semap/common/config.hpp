@@ -27,6 +27,8 @@ class ConfigSection {
   static ConfigSection load_string(const std::string& yaml, const std::string& name = "<string>");
 
   bool has(const std::string& key) const;
+  // Whether the value is a list (for keys that take a scalar or a list).
+  bool is_list(const std::string& key) const;
 
   // Required value.
   template <typename T>

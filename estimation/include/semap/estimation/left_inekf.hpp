@@ -18,10 +18,13 @@ namespace semap::estimation {
 //
 // The covariance is stored for the world-aligned form of that same error, xi_w = Ad_X xi
 // (X = exp(xi_w) X_hat), where the group part of the transition is a constant gravity shear
-// (see InekfImuStep). Its propagation is deferred exactly (CovarianceWindow): propagate()
-// only accumulates running sums, and the covariance is formed when a correction, a query,
-// an origin move or an inflation needs it, and at the latest every `max_window_steps` steps
-// or 0.32 s, which bounds rounding and gives a long IMU-only run its share of the cost.
+// (see InekfImuStep). Its propagation is the textbook P <- Phi (P + Q dt) Phi^T
+// (inekf_propagation.hpp), with per-axis IMU noise. By default it is deferred exactly
+// (CovarianceWindow): propagate() only accumulates running sums, and the covariance is formed
+// when a correction, a query, an origin move or an inflation needs it, and at the latest
+// every `max_window_steps` steps or 0.32 s, which bounds rounding and gives a long IMU-only
+// run its share of the cost. With max_window_steps = 1 every step runs the textbook
+// propagation itself (the reference the window is tested against).
 // Queries are const and cache their result without ending the window, so the filter's output
 // does not depend on who reads it when (that cache makes concurrent const reads unsafe; the
 // filter has one owner thread, like Estimator).
@@ -35,7 +38,7 @@ class LeftInekf final : public NavFilter {
  public:
   static constexpr int kDefaultWindowSteps = 32;
 
-  // max_window_steps = 1 propagates the covariance at every step.
+  // max_window_steps = 1: the per-step textbook propagation (propagate_world_covariance).
   explicit LeftInekf(const FilterParams& params, int max_window_steps = kDefaultWindowSteps);
 
   void reset(const NavState& state, const Matrix15& world_covariance) override;
@@ -85,8 +88,5 @@ class LeftInekf final : public NavFilter {
   mutable bool cache_valid_ = false;
   unsigned steps_since_normalise_ = 0;
 };
-
-// Diagonal of the continuous process noise Q shared by both filters.
-Eigen::Matrix<double, 15, 1> process_noise_diagonal(const ImuNoise& noise);
 
 }  // namespace semap::estimation

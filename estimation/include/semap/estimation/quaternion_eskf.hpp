@@ -37,7 +37,8 @@ class QuaternionEskf final : public NavFilter {
   void inject(const Vector15& delta);
 
   FilterParams params_;
-  Eigen::Matrix<double, 15, 1> q_diag_;
+  Vector15 q_diag_;          // Q, with the velocity block in accel_q_ instead
+  Eigen::Vector3d accel_q_;  // body-frame accel noise densities squared
   Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
   Eigen::Vector3d v_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_pos_ = Eigen::Vector3d::Zero();
