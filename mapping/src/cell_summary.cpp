@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include "semap/common/cell_posterior.hpp"
 #include "semap/mapping/logodds.hpp"
 
 namespace semap::mapping {
@@ -32,13 +33,19 @@ CellSummary summarize(const LayeredMapParams& params, std::span<const float> fus
     s.variance = s.probability * (1.0f - s.probability);
     return s;
   }
-  const double alpha0 = std::accumulate(fused.begin(), fused.end(), 0.0);
+  // S-BKI / S-CSM: fused channels are alpha = alpha_0 + evidence, read with a zero prior, and
+  // cells more uncertain than the map's own threshold are unknown, as on the robot.
   const auto prior = static_cast<float>(params.prior);
-  s.known = std::any_of(fused.begin(), fused.end(), [&](float v) { return v > prior; });
+  const auto threshold = params.extra.find("bki.unknown_variance");
+  const float unknown_variance =
+      threshold == params.extra.end() ? 0.0f : static_cast<float>(threshold->second);
+  const common::CellPosterior cell(
+      fused, 0.0f, std::any_of(fused.begin(), fused.end(), [&](float v) { return v > prior; }));
+  const common::CellState state = cell.state(unknown_variance);
+  s.known = state != common::CellState::kUnknown;
+  s.occupied = state == common::CellState::kOccupied;
   s.occupancy = static_cast<float>(1.0 - p[0]);
-  s.occupied = s.known && s.label != 0;
-  const double a = fused[static_cast<std::size_t>(s.label)];
-  s.variance = static_cast<float>(a * (alpha0 - a) / (alpha0 * alpha0 * (alpha0 + 1.0)));
+  s.variance = cell.variance(s.label);
   return s;
 }
 
