@@ -76,8 +76,7 @@ std::vector<dds_idl::BlockSnapshot> MappingStage::snapshots_of(
   out.reserve(updated.size());
   for (const auto& index : updated) {
     if (const auto* block = map_.find_block(index)) {
-      const common::BlockIndex key{index.x, index.y, index.z};
-      out.push_back(to_snapshot(map_, index, *block, ++versions_[key]));
+      out.push_back(to_snapshot(map_, index, *block, ++versions_[index]));
     }
   }
   return out;

@@ -70,10 +70,10 @@ FilterParams per_axis_params() {
   return params;
 }
 
+// One IMU step per iteration, cycling through the recorded inputs.
 template <typename Filter>
-void propagate(benchmark::State& state) {
+void run_propagate(benchmark::State& state, Filter& f) {
   const Inputs in;
-  Filter f{FilterParams{}};
   f.reset(start_state(), start_covariance());
   std::size_t i = 0;
   for (auto _ : state) {
@@ -83,18 +83,17 @@ void propagate(benchmark::State& state) {
   }
 }
 
+template <typename Filter>
+void propagate(benchmark::State& state) {
+  Filter f{FilterParams{}};
+  run_propagate(state, f);
+}
+
 // LeftInekf with per-axis noise and `window` steps per covariance window (1: plain per-step).
 template <int window>
 void inekf_propagate_per_axis(benchmark::State& state) {
-  const Inputs in;
   semap::estimation::LeftInekf f(per_axis_params(), window);
-  f.reset(start_state(), start_covariance());
-  std::size_t i = 0;
-  for (auto _ : state) {
-    f.propagate(in.gyro[i], in.accel[i], 0.01);
-    i = (i + 1) % kInputs;
-    benchmark::DoNotOptimize(f);
-  }
+  run_propagate(state, f);
 }
 
 template <typename Filter>

@@ -4,7 +4,6 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -149,36 +148,22 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
 }
 
 common::BlockIndex SemanticMap::block_of(const Eigen::Vector3f& point) const {
-  // Through the cell index, exactly as insert() and query() do, so boundaries agree.
-  const float inv_res = 1.0f / params_.resolution;
-  const std::int32_t n = params_.cells_per_side();
-  return {common::floor_div(detail::fast_floor(point.x() * inv_res), n),
-          common::floor_div(detail::fast_floor(point.y() * inv_res), n),
-          common::floor_div(detail::fast_floor(point.z() * inv_res), n)};
+  return params_.grid().block_of(point);
 }
 
 Eigen::Vector3f SemanticMap::cell_center(const common::BlockIndex& block, int cell) const {
-  const int n = params_.cells_per_side();
-  const Eigen::Vector3f local(static_cast<float>(cell % n), static_cast<float>((cell / n) % n),
-                              static_cast<float>(cell / (n * n)));
-  const Eigen::Vector3f first(static_cast<float>(block.x * n), static_cast<float>(block.y * n),
-                              static_cast<float>(block.z * n));
-  return (first + local + Eigen::Vector3f::Constant(0.5f)) * params_.resolution;
+  const common::MapGrid grid = params_.grid();
+  return grid.cell_centre(grid.cell_of_local(block, cell));
 }
 
 std::optional<common::CellPosterior> SemanticMap::query(const Eigen::Vector3f& point) const {
-  const float inv_res = 1.0f / params_.resolution;
-  if (!detail::mappable(point, inv_res)) return std::nullopt;
-  const std::int32_t n = params_.cells_per_side();
-  const std::array<std::int32_t, 3> cell{
-      static_cast<std::int32_t>(std::floor(point.x() * inv_res)),
-      static_cast<std::int32_t>(std::floor(point.y() * inv_res)),
-      static_cast<std::int32_t>(std::floor(point.z() * inv_res))};
-  const common::BlockIndex index{common::floor_div(cell[0], n), common::floor_div(cell[1], n),
-                                 common::floor_div(cell[2], n)};
+  if (!detail::mappable(point, 1.0f / params_.resolution)) return std::nullopt;
+  const common::MapGrid grid = params_.grid();
+  const common::CellIndex cell = grid.cell_of(point);
+  const common::BlockIndex index = grid.block_of(cell);
   const Block* block = find_block(index);
   if (block == nullptr) return std::nullopt;
-  const int c = block->cell_of(cell[0] - index.x * n, cell[1] - index.y * n, cell[2] - index.z * n);
+  const int c = grid.local_index(cell, index);
   return common::CellPosterior(block->cell_evidence(c), params_.prior, block->observed(c));
 }
 

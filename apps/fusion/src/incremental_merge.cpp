@@ -36,8 +36,8 @@ std::vector<common::BlockIndex> blocks_between(const common::CellIndex& first,
                                                const common::CellIndex& last, int side) {
   std::vector<common::BlockIndex> out;
   if ((last.array() < first.array()).any()) return out;
-  const common::BlockIndex b0 = semap::common::block_of_cell(first, side);
-  const common::BlockIndex b1 = semap::common::block_of_cell(last, side);
+  const common::BlockIndex b0 = common::block_of_cell(first, side);
+  const common::BlockIndex b1 = common::block_of_cell(last, side);
   for (int z = b0.z; z <= b1.z; ++z) {
     for (int y = b0.y; y <= b1.y; ++y) {
       for (int x = b0.x; x <= b1.x; ++x) out.push_back({x, y, z});

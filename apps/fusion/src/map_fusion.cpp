@@ -63,9 +63,8 @@ void MapFusion::take_blocks(Robot& robot) {
       }
       continue;
     }
-    const common::BlockIndex key = index;
-    layer.put_block(key, evidence_block(block, params_));
-    robot.changed.push_back(key);
+    layer.put_block(index, evidence_block(block, params_));
+    robot.changed.push_back(index);
     ++robot.counters.blocks;
   }
   // The update count orders copies of a layer, as in the mapping library (merge_into, .smap).
