@@ -380,7 +380,7 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   if (map.checkpoint.checkpoints > 0 || map.checkpoint.resumed_scans > 0) {
     std::printf(
         "map checkpoint   : %s, %lu checkpoints, %lu blocks written, write max %.1f ms, "
-        "%.1f MB; resumed %lu blocks of %lu scans\n",
+        "%.1f MB, resumed %lu blocks of %lu scans\n",
         checkpoint_path.c_str(), map.checkpoint.checkpoints, map.checkpoint.blocks_written,
         1e3 * map.checkpoint.max_write_s, static_cast<double>(map.checkpoint.log_bytes) / 1e6,
         map.checkpoint.resumed_blocks, map.checkpoint.resumed_scans);

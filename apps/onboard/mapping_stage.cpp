@@ -9,6 +9,18 @@
 
 namespace semap::onboard {
 
+dds_idl::MapDescription describe_map(const OnboardConfig& config) {
+  dds_idl::MapDescription d;
+  d.resolution = config.map.resolution;
+  d.block_cells = static_cast<std::uint16_t>(config.map.cells_per_side());
+  d.num_classes = static_cast<std::uint16_t>(config.map.num_classes);
+  d.class_names = config.map_palette.names;
+  for (const mapping::Rgb& rgb : config.map_palette.colors) {
+    d.class_colors.push_back(std::uint32_t{rgb[0]} << 16 | std::uint32_t{rgb[1]} << 8 | rgb[2]);
+  }
+  return d;
+}
+
 dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
                                    const mapping::Block& block, std::uint32_t version) {
   const auto& params = map.params();

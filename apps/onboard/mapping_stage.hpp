@@ -13,6 +13,7 @@
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/dds_idl/block_snapshot.hpp"
+#include "semap/dds_idl/map_description.hpp"
 #include "semap/mapping/map_checkpoint.hpp"
 #include "semap/mapping/semantic_map.hpp"
 
@@ -81,6 +82,9 @@ class MappingStage {
   LatencyWindow latency_;
   std::jthread thread_;
 };
+
+// The map's shape and its palette's class names and colours (0xRRGGBB), for MapInfo.
+dds_idl::MapDescription describe_map(const OnboardConfig& config);
 
 // A block of the map in the form the DDS layer publishes.
 dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,

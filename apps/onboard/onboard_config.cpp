@@ -192,6 +192,9 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   const auto map = root.section_or_empty("map");
   c.map = mapping::map_params_from_config(map, c.map);
   c.map_save_path = map.get<std::string>("save_path", "");
+  c.map_palette = map.has("palette")
+                      ? mapping::load_palette(map.get<std::string>("palette"), c.map.num_classes)
+                      : mapping::ClassPalette::defaults(c.map.num_classes);
   c.map_checkpoint_path = map.get<std::string>("checkpoint_path", "");
   c.map_checkpoint_s = map.get_in_range("checkpoint_s", c.map_checkpoint_s, 0.0, 3600.0);
   c.map_resume = map.get<bool>("resume", false);

@@ -12,6 +12,7 @@
 #include "semap/estimation/estimator_config.hpp"
 #include "semap/estimation/simulator.hpp"
 #include "semap/firmware_bridge/emulator.hpp"
+#include "semap/mapping/class_palette.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/semantic_layers.hpp"
 #include "sim_camera_feed.hpp"
@@ -72,6 +73,9 @@ struct OnboardConfig {
   estimation::EstimatorConfig estimator;
   mapping::MapParams map;
   std::string map_save_path;  // .smap written at exit when set
+  // Names and colours of the map's classes (map.palette, a YAML file as semap-export reads),
+  // published in MapInfo for planners and viewers.
+  mapping::ClassPalette map_palette;
   // The live map's crash-safe checkpoint (mapping::MapCheckpoint): a block log written every
   // map_checkpoint_s (0: none). An empty path means <save_path>.log, or map.log in the
   // --report directory, or no checkpoint when neither is given.
