@@ -25,7 +25,51 @@ Eigen::Matrix3d floor_variances(Eigen::Matrix3d c) {
   return c;
 }
 
+constexpr std::int64_t kMsPerDay = 86'400'000;
+
+common::FixMode mode_from_nav_pvt(const SemapUbxNavPvt& pvt) {
+  using common::FixMode;
+  if (!(pvt.flags & SEMAP_UBX_PVT_FLAG_GNSS_FIX_OK) || pvt.fix_type == 0 || pvt.fix_type == 5) {
+    return FixMode::kNoFix;
+  }
+  const unsigned carrier = (pvt.flags >> SEMAP_UBX_PVT_CARR_SOLN_SHIFT) & 0x03u;
+  if (carrier == 2) return FixMode::kRtkFixed;
+  if (carrier == 1) return FixMode::kRtkFloat;
+  if (pvt.flags & SEMAP_UBX_PVT_FLAG_DIFF_SOLN) return FixMode::kDgps;
+  // fixType 1 (dead reckoning only) and 4 (GNSS + DR) are 3D solutions, as gpsd reports them.
+  return pvt.fix_type == 2 ? FixMode::k2D : FixMode::k3D;
+}
+
 }  // namespace
+
+std::int64_t days_from_civil(int year, unsigned month, unsigned day) {
+  const std::int64_t y = static_cast<std::int64_t>(year) - (month <= 2 ? 1 : 0);
+  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const auto yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (month > 2 ? month - 3 : month + 9) + 2) / 5 + day - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+common::FixMode mode_from_gga(std::uint8_t quality, bool has_altitude) {
+  using common::FixMode;
+  switch (quality) {
+    case 0:
+      return FixMode::kNoFix;
+    case 2:
+      return FixMode::kDgps;
+    case 4:
+      return FixMode::kRtkFixed;
+    case 5:
+      return FixMode::kRtkFloat;
+    case 1:  // GPS
+    case 3:  // PPS
+    case 6:  // dead reckoning
+      return has_altitude ? FixMode::k3D : FixMode::k2D;
+    default:  // 7 manual input, 8 simulation: not a measurement of where we are
+      return FixMode::kNoFix;
+  }
+}
 
 Eigen::Matrix3d covariance_from_gst(const SemapNmeaGst& gst) {
   Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
@@ -61,6 +105,14 @@ common::GnssFix fix_from_nav_pvt(const SemapUbxNavPvt& pvt, common::Stamp stamp)
   fix.longitude_deg = pvt.lon_1e7_deg * 1e-7;
   fix.altitude_m = pvt.height_mm * 1e-3;
   fix.satellites = pvt.num_sv;
+  fix.mode = mode_from_nav_pvt(pvt);
+  const unsigned both = SEMAP_UBX_PVT_VALID_DATE | SEMAP_UBX_PVT_VALID_TIME;
+  if ((pvt.valid & both) == both && pvt.month >= 1 && pvt.day >= 1) {
+    const std::int64_t ms_of_day = ((pvt.hour * 60 + pvt.min) * 60 + pvt.sec) * 1000LL;
+    const std::int64_t days = days_from_civil(pvt.year, pvt.month, pvt.day);
+    // nano is the fraction of the second, -1e9..1e9: the rounded seconds may be one ahead.
+    fix.utc_ns = (days * kMsPerDay + ms_of_day) * 1'000'000 + pvt.nano_ns;
+  }
   const unsigned carrier = (pvt.flags >> SEMAP_UBX_PVT_CARR_SOLN_SHIFT) & 0x03u;
   if (!(pvt.flags & SEMAP_UBX_PVT_FLAG_GNSS_FIX_OK) || pvt.fix_type == 0 || pvt.fix_type == 5) {
     fix.quality = common::FixQuality::kInvalid;
@@ -98,6 +150,10 @@ std::optional<common::GnssFix> GnssFixBuilder::add(const SemapNmeaSentence& sent
       return std::nullopt;
     case SEMAP_NMEA_RMC:
       rmc_ = sentence.u.rmc;
+      if (rmc_->has_date) {
+        date_days_ = days_from_civil(rmc_->year, rmc_->month, rmc_->day);
+        date_time_ms_ = rmc_->has_time ? rmc_->time_ms : -1;
+      }
       return std::nullopt;
     case SEMAP_NMEA_VTG:
       vtg_ = sentence.u.vtg;
@@ -114,6 +170,16 @@ std::optional<common::GnssFix> GnssFixBuilder::add(const SemapNmeaSentence& sent
   fix.longitude_deg = gga.longitude_deg;
   fix.altitude_m = (gga.has_altitude ? gga.altitude_msl_m : 0.0) +
                    (gga.has_geoid ? gga.geoid_separation_m : 0.0);
+  fix.mode =
+      gga.has_position ? mode_from_gga(gga.quality, gga.has_altitude) : common::FixMode::kNoFix;
+  if (gga.has_time && date_days_) {
+    std::int64_t days = *date_days_;
+    // The date belongs to the RMC's time of day: GGA just after midnight with the RMC of the
+    // epoch before it is on the next day (and the other way round).
+    if (date_time_ms_ >= 0 && gga.time_ms < date_time_ms_ - kMsPerDay / 2) ++days;
+    if (date_time_ms_ >= 0 && gga.time_ms > date_time_ms_ + kMsPerDay / 2) --days;
+    fix.utc_ns = (days * kMsPerDay + gga.time_ms) * 1'000'000;
+  }
 
   const bool same_time_gst = gst_ && gst_->has_time && gga.has_time && gst_->time_ms == gga.time_ms;
   if (gst_ && (same_time_gst || seconds_between(stamp, gst_stamp_) <= config_.gst_max_age_s)) {

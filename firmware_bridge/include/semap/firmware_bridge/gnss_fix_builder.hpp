@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 
 #include "semap/common/messages.hpp"
@@ -18,8 +19,9 @@ struct GnssFixBuilderConfig {
 };
 
 // Combines the sentences of one NMEA epoch into a GnssFix. The fix is emitted on GGA, with the
-// covariance of the latest GST (same UTC time, or not older than gst_max_age_s) and the velocity
-// of an RMC with the same UTC time or a VTG received since the previous GGA.
+// covariance of the latest GST (same UTC time, or not older than gst_max_age_s), the velocity
+// of an RMC with the same UTC time or a VTG received since the previous GGA, and the UTC time of
+// GGA on the date of the latest RMC (a day later or earlier when GGA's time of day wrapped).
 class GnssFixBuilder {
  public:
   explicit GnssFixBuilder(const GnssFixBuilderConfig& config = {});
@@ -32,14 +34,24 @@ class GnssFixBuilder {
   common::Stamp gst_stamp_;
   std::optional<SemapNmeaRmc> rmc_;
   std::optional<SemapNmeaVtg> vtg_;  // cleared at every GGA
+  // Date of the latest RMC that had one, as days since 1970-01-01, and that RMC's time of day.
+  std::optional<std::int64_t> date_days_;
+  std::int32_t date_time_ms_ = 0;
 };
+
+// Days since 1970-01-01 of a proleptic Gregorian date (H. Hinnant's days_from_civil).
+std::int64_t days_from_civil(int year, unsigned month, unsigned day);
+// Fix mode from GGA quality (0..8) and whether GGA carried an altitude.
+common::FixMode mode_from_gga(std::uint8_t quality, bool has_altitude);
 
 // ENU position covariance from a GST error ellipse (falls back to lat/lon sigmas).
 Eigen::Matrix3d covariance_from_gst(const SemapNmeaGst& gst);
 // ENU velocity from speed over ground and course (deg from true north); vertical is zero.
 Eigen::Vector3d velocity_from_course(double speed_mps, double course_deg);
 // Fix from a UBX NAV-PVT: ellipsoid height, hAcc split equally over east and north, velocity
-// from velN/velE/velD. Invalid when gnssFixOK is clear or the fix type is "none"/"time only".
+// from velN/velE/velD, mode from fixType and the diffSoln / carrSoln flags, UTC from the date
+// and time when validDate and validTime are set. Invalid when gnssFixOK is clear or the fix type
+// is "none"/"time only".
 common::GnssFix fix_from_nav_pvt(const SemapUbxNavPvt& pvt, common::Stamp stamp);
 
 }  // namespace semap::firmware_bridge
