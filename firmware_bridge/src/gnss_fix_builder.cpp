@@ -73,17 +73,29 @@ common::FixMode mode_from_gga(std::uint8_t quality, bool has_altitude) {
 
 Eigen::Matrix3d covariance_from_gst(const SemapNmeaGst& gst) {
   Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
-  if (gst.has_ellipse && gst.semi_major_m > 0.0) {
+  Eigen::Matrix2d ellipse = Eigen::Matrix2d::Zero();
+  const bool has_ellipse = gst.has_ellipse && gst.semi_major_m > 0.0;
+  if (has_ellipse) {
     // Orientation is of the semi-major axis, clockwise from true north; in ENU that axis is
     // (sin, cos) and the minor axis is perpendicular to it.
     const double t = gst.orientation_deg * std::numbers::pi / 180.0;
     const Eigen::Vector2d major(std::sin(t), std::cos(t));
     const Eigen::Vector2d minor(std::cos(t), -std::sin(t));
-    c.topLeftCorner<2, 2>() = gst.semi_major_m * gst.semi_major_m * major * major.transpose() +
-                              gst.semi_minor_m * gst.semi_minor_m * minor * minor.transpose();
-  } else if (gst.has_lat_sd && gst.has_lon_sd) {
+    ellipse = gst.semi_major_m * gst.semi_major_m * major * major.transpose() +
+              gst.semi_minor_m * gst.semi_minor_m * minor * minor.transpose();
+  }
+  if (gst.has_lat_sd && gst.has_lon_sd) {
+    // NMEA defines the latitude and longitude errors as 1-sigma; receivers disagree about the
+    // ellipse's scale (a u-blox NEO-M9N prints a 95 % ellipse, 2.45 times its lat/lon sigmas;
+    // an ST Teseo one smaller than them), so the ellipse only lends its orientation.
     c(0, 0) = gst.lon_sd_m * gst.lon_sd_m;
     c(1, 1) = gst.lat_sd_m * gst.lat_sd_m;
+    const double scale = std::sqrt(ellipse(0, 0) * ellipse(1, 1));
+    if (has_ellipse && scale > 0.0) {
+      c(0, 1) = c(1, 0) = ellipse(0, 1) / scale * gst.lon_sd_m * gst.lat_sd_m;
+    }
+  } else if (has_ellipse) {
+    c.topLeftCorner<2, 2>() = ellipse;
   } else {
     const double s = gst.has_rms ? gst.rms_m : kUnknownSigma;
     c(0, 0) = c(1, 1) = s * s;
@@ -144,24 +156,72 @@ GnssFixBuilder::GnssFixBuilder(const GnssFixBuilderConfig& config) : config_(con
 std::optional<common::GnssFix> GnssFixBuilder::add(const SemapNmeaSentence& sentence,
                                                    common::Stamp stamp) {
   switch (sentence.type) {
-    case SEMAP_NMEA_GST:
+    case SEMAP_NMEA_GST: {
       gst_ = sentence.u.gst;
       gst_stamp_ = stamp;
-      return std::nullopt;
+      const std::int32_t t = gst_->has_time ? gst_->time_ms : -1;
+      if (pending_ && t >= 0 && t == pending_time_ms_) {
+        pending_->covariance = covariance_from_gst(*gst_);
+        return take_pending();
+      }
+      // The GST of a fix already emitted: from now on hold GGA until its GST.
+      if (!pending_ && t >= 0 && t == last_gga_time_ms_) gst_after_gga_ = true;
+      return flush_other_epoch(t);
+    }
     case SEMAP_NMEA_RMC:
       rmc_ = sentence.u.rmc;
       if (rmc_->has_date) {
         date_days_ = days_from_civil(rmc_->year, rmc_->month, rmc_->day);
         date_time_ms_ = rmc_->has_time ? rmc_->time_ms : -1;
       }
-      return std::nullopt;
+      return flush_other_epoch(rmc_->has_time ? rmc_->time_ms : -1);
     case SEMAP_NMEA_VTG:
-      vtg_ = sentence.u.vtg;
+      if (pending_ && !pending_->velocity_enu) {
+        // VTG has no time: one between a held GGA and its GST belongs to that epoch.
+        apply_vtg(sentence.u.vtg, *pending_);
+      } else {
+        vtg_ = sentence.u.vtg;
+      }
       return std::nullopt;
     case SEMAP_NMEA_GGA:
       break;
   }
   const SemapNmeaGga& gga = sentence.u.gga;
+  common::GnssFix fix = build(gga, stamp);
+  std::optional<common::GnssFix> out;
+  if (pending_) {
+    gst_after_gga_ = false;  // the held epoch's GST never came: stop waiting for one
+    out = take_pending();
+  }
+  last_gga_time_ms_ = gga.has_time ? gga.time_ms : -1;
+  const bool same_time_gst = gst_ && gst_->has_time && gga.has_time && gst_->time_ms == gga.time_ms;
+  if ((gst_after_gga_ && gga.has_time && !same_time_gst) || out) {
+    pending_ = fix;
+    pending_time_ms_ = last_gga_time_ms_;
+    return out;
+  }
+  return fix;
+}
+
+std::optional<common::GnssFix> GnssFixBuilder::take_pending() {
+  std::optional<common::GnssFix> out = std::move(pending_);
+  pending_.reset();
+  return out;
+}
+
+std::optional<common::GnssFix> GnssFixBuilder::flush_other_epoch(std::int32_t time_ms) {
+  if (!pending_ || time_ms < 0 || time_ms == pending_time_ms_) return std::nullopt;
+  gst_after_gga_ = false;
+  return take_pending();
+}
+
+void GnssFixBuilder::apply_vtg(const SemapNmeaVtg& vtg, common::GnssFix& fix) const {
+  if (!vtg.has_course_true || !(vtg.has_speed_kmh || vtg.has_speed_knots)) return;
+  const double speed = vtg.has_speed_kmh ? vtg.speed_kmh * kKmhToMps : vtg.speed_knots * kKnotToMps;
+  fix.velocity_enu = velocity_from_course(speed, vtg.course_true_deg);
+}
+
+common::GnssFix GnssFixBuilder::build(const SemapNmeaGga& gga, common::Stamp stamp) {
   common::GnssFix fix;
   fix.stamp = stamp;
   fix.quality = gga.has_position ? quality_from_gga(gga.quality) : common::FixQuality::kInvalid;
@@ -192,10 +252,8 @@ std::optional<common::GnssFix> GnssFixBuilder::add(const SemapNmeaSentence& sent
   const bool same_time_rmc = rmc_ && rmc_->has_time && gga.has_time && rmc_->time_ms == gga.time_ms;
   if (same_time_rmc && rmc_->valid && rmc_->has_speed && rmc_->has_course) {
     fix.velocity_enu = velocity_from_course(rmc_->speed_knots * kKnotToMps, rmc_->course_deg);
-  } else if (vtg_ && vtg_->has_course_true && (vtg_->has_speed_kmh || vtg_->has_speed_knots)) {
-    const double speed =
-        vtg_->has_speed_kmh ? vtg_->speed_kmh * kKmhToMps : vtg_->speed_knots * kKnotToMps;
-    fix.velocity_enu = velocity_from_course(speed, vtg_->course_true_deg);
+  } else if (vtg_) {
+    apply_vtg(*vtg_, fix);
   }
   vtg_.reset();
   return fix;

@@ -22,6 +22,9 @@ struct GnssFixBuilderConfig {
 // covariance of the latest GST (same UTC time, or not older than gst_max_age_s), the velocity
 // of an RMC with the same UTC time or a VTG received since the previous GGA, and the UTC time of
 // GGA on the date of the latest RMC (a day later or earlier when GGA's time of day wrapped).
+// Receivers that send GST after GGA (u-blox, ST Teseo) are learned from their first epoch: from
+// then on GGA is held until the GST of its time (a VTG in between gives the velocity), or is
+// emitted with the older accuracy when a sentence of the next epoch comes first.
 class GnssFixBuilder {
  public:
   explicit GnssFixBuilder(const GnssFixBuilderConfig& config = {});
@@ -33,7 +36,17 @@ class GnssFixBuilder {
   std::optional<SemapNmeaGst> gst_;
   common::Stamp gst_stamp_;
   std::optional<SemapNmeaRmc> rmc_;
-  std::optional<SemapNmeaVtg> vtg_;  // cleared at every GGA
+  std::optional<common::GnssFix> take_pending();
+  // Emits a held fix when `time_ms` (>= 0) belongs to another epoch.
+  std::optional<common::GnssFix> flush_other_epoch(std::int32_t time_ms);
+  void apply_vtg(const SemapNmeaVtg& vtg, common::GnssFix& fix) const;
+  common::GnssFix build(const SemapNmeaGga& gga, common::Stamp stamp);
+
+  std::optional<SemapNmeaVtg> vtg_;         // cleared at every GGA
+  std::optional<common::GnssFix> pending_;  // a GGA's fix waiting for the GST of its time
+  std::int32_t pending_time_ms_ = -1;
+  std::int32_t last_gga_time_ms_ = -1;
+  bool gst_after_gga_ = false;
   // Date of the latest RMC that had one, as days since 1970-01-01, and that RMC's time of day.
   std::optional<std::int64_t> date_days_;
   std::int32_t date_time_ms_ = 0;
@@ -44,7 +57,8 @@ std::int64_t days_from_civil(int year, unsigned month, unsigned day);
 // Fix mode from GGA quality (0..8) and whether GGA carried an altitude.
 common::FixMode mode_from_gga(std::uint8_t quality, bool has_altitude);
 
-// ENU position covariance from a GST error ellipse (falls back to lat/lon sigmas).
+// ENU position covariance from GST: the 1-sigma latitude / longitude / altitude errors, with the
+// correlation of the error ellipse; the ellipse alone when those are empty, then the range RMS.
 Eigen::Matrix3d covariance_from_gst(const SemapNmeaGst& gst);
 // ENU velocity from speed over ground and course (deg from true north); vertical is zero.
 Eigen::Vector3d velocity_from_course(double speed_mps, double course_deg);
