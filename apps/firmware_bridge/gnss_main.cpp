@@ -161,9 +161,7 @@ class Recorder {
   std::string path_;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{
       "Decode a GNSS receiver's stream (NMEA, UBX; RTCM3 and text lines skipped) from a raw "
       "capture or a serial device: one line (or JSON object) per fix, then the counters"};
@@ -248,4 +246,17 @@ int main(int argc, char** argv) {
   }
   print_counters(decoder.counters(), json);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "semap-gnss: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "semap-gnss: unknown error\n");
+  }
+  return 1;
 }
