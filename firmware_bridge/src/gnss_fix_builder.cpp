@@ -165,7 +165,9 @@ std::optional<common::GnssFix> GnssFixBuilder::add(const SemapNmeaSentence& sent
         return take_pending();
       }
       // The GST of a fix already emitted: from now on hold GGA until its GST.
-      if (!pending_ && t >= 0 && t == last_gga_time_ms_) gst_after_gga_ = true;
+      if (config_.wait_for_gst && !pending_ && t >= 0 && t == last_gga_time_ms_) {
+        gst_after_gga_ = true;
+      }
       return flush_other_epoch(t);
     }
     case SEMAP_NMEA_RMC:

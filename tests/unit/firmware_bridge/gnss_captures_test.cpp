@@ -123,10 +123,10 @@ struct Replay {
 
 // Feeds the whole file (gpsd's '#' header included: the framer skips it as text lines) in
 // chunks of `chunk` bytes.
-Replay replay(const std::string& name, std::size_t chunk) {
+Replay replay(const std::string& name, std::size_t chunk, const GnssFixBuilderConfig& config = {}) {
   const std::vector<std::uint8_t> bytes = read_bytes(kDir + name);
   EXPECT_FALSE(bytes.empty()) << kDir + name;
-  GnssStreamDecoder decoder;
+  GnssStreamDecoder decoder(config);
   Replay r;
   for (std::size_t pos = 0; pos < bytes.size(); pos += chunk) {
     const std::size_t n = std::min(chunk, bytes.size() - pos);
@@ -148,7 +148,9 @@ std::string describe(const GnssStreamCounters& c) {
 
 // Every gpsd fix has one of ours at the same UTC time with the same position, altitude and
 // mode, and we have no fix gpsd does not, except at the times in `extra`.
-enum class Accuracy { kGst, kNavPvt };
+// kGst: the covariance is the GST of the epoch before (GST follows GGA in both captures and
+// the robot does not wait for it); kGstSameEpoch: of the same epoch (wait_for_gst).
+enum class Accuracy { kGst, kGstSameEpoch, kNavPvt };
 
 void expect_same_fixes_as_gpsd(const std::string& name, const Replay& r, Accuracy accuracy,
                                const std::set<std::string>& extra = {}) {
@@ -185,11 +187,11 @@ void expect_same_fixes_as_gpsd(const std::string& name, const Replay& r, Accurac
       EXPECT_NEAR(std::sqrt(c(0, 0) + c(1, 1)), g.eph, 1e-3) << name << " " << time;
       EXPECT_NEAR(std::sqrt(c(2, 2)), g.epv, 1e-3) << name << " " << time;
     } else if (time != gpsd.begin()->first) {
-      // The GST of the same epoch: 1-sigma latitude, longitude and altitude errors. Both
-      // receivers send GST after GGA; the builder learns that in the first epoch, whose fix
-      // goes out with the HDOP-based covariance.
-      const auto gst = gsts.find(time);
+      // 1-sigma latitude, longitude and altitude errors of GST. The first epoch's fix goes out
+      // before any GST, with the HDOP-based covariance.
+      auto gst = gsts.find(time);
       ASSERT_NE(gst, gsts.end()) << name << " " << time;
+      if (accuracy == Accuracy::kGst) --gst;
       EXPECT_NEAR(std::sqrt(c(0, 0)), gst->second.lon, 1e-9) << name << " " << time;
       EXPECT_NEAR(std::sqrt(c(1, 1)), gst->second.lat, 1e-9) << name << " " << time;
       EXPECT_NEAR(std::sqrt(c(2, 2)), gst->second.alt, 1e-9) << name << " " << time;
@@ -221,6 +223,9 @@ TEST(GnssCaptures, StTeseoDoubledDollarAndBdTalker) {
   const std::string name = "st-teseo-liv4f.log";
   const Replay r = replay(name, 61);
   expect_same_fixes_as_gpsd(name, r, Accuracy::kGst);
+  GnssFixBuilderConfig wait;
+  wait.wait_for_gst = true;
+  expect_same_fixes_as_gpsd(name, replay(name, 61, wait), Accuracy::kGstSameEpoch);
   EXPECT_EQ(r.fixes.size(), 12u);
   EXPECT_EQ(r.counters.garbage_bytes, 0u) << "the doubled $ is not garbage";
   EXPECT_EQ(r.counters.text_lines, 8u);       // the '#' header
@@ -237,6 +242,9 @@ TEST(GnssCaptures, UbloxM9nMultiConstellationNmea) {
   const std::string name = "ublox-neo-m9n-nmea.log";
   const Replay r = replay(name, 512);
   expect_same_fixes_as_gpsd(name, r, Accuracy::kGst);
+  GnssFixBuilderConfig wait;
+  wait.wait_for_gst = true;
+  expect_same_fixes_as_gpsd(name, replay(name, 512, wait), Accuracy::kGstSameEpoch);
   EXPECT_EQ(r.fixes.size(), 61u);
   EXPECT_EQ(r.counters.garbage_bytes, 0u);
   EXPECT_EQ(r.counters.text_lines, 11u);

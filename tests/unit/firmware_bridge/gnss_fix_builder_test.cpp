@@ -80,8 +80,24 @@ TEST(GnssFixBuilder, UtcIsGgaTimeOnTheRmcDateAcrossMidnight) {
   EXPECT_EQ(*fix->utc_ns, utc_ns(2026, 1, 1, 0, 0, 0.5));
 }
 
-TEST(GnssFixBuilder, WaitsForTheGstThatFollowsGgaOnceItHasSeenOne) {
+TEST(GnssFixBuilder, EmitsAtGgaWithTheLastGstByDefault) {
   GnssFixBuilder builder;
+  const std::string gga_tail = ",4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,";
+  const auto stamp = [](double s) { return common::Stamp::from_seconds(s); };
+  ASSERT_TRUE(builder.add(nmea("GPGGA,120001.00" + gga_tail), stamp(1.0)));
+  EXPECT_FALSE(builder.add(nmea("GPGST,120001.00,1.0,2.0,1.0,0.0,0.5,0.4,0.9"), stamp(1.01)));
+  // Epoch 2 goes out at its GGA, with epoch 1's GST (0.99 s old).
+  const auto fix = builder.add(nmea("GPGGA,120002.00" + gga_tail), stamp(2.0));
+  ASSERT_TRUE(fix);
+  EXPECT_EQ(fix->stamp, stamp(2.0));
+  EXPECT_NEAR(fix->covariance(2, 2), 0.9 * 0.9, 1e-12);
+  EXPECT_FALSE(builder.add(nmea("GPGST,120002.00,1.0,2.0,1.0,0.0,0.5,0.4,0.8"), stamp(2.01)));
+}
+
+TEST(GnssFixBuilder, WaitsForTheGstThatFollowsGgaOnceItHasSeenOne) {
+  GnssFixBuilderConfig config;
+  config.wait_for_gst = true;
+  GnssFixBuilder builder(config);
   const std::string gga_tail = ",4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,";
   const std::string gst_tail = ",1.0,2.0,1.0,0.0,0.5,0.4,0.9";
   const auto stamp = [](double s) { return common::Stamp::from_seconds(s); };

@@ -16,15 +16,21 @@ struct GnssFixBuilderConfig {
   double uere_m = 3.0;
   // A GST from an earlier epoch is reused for this long (accuracy changes slowly).
   double gst_max_age_s = 1.5;
+  // Receivers that send GST after GGA (u-blox, ST Teseo: 20 sentences later on an M9N, about
+  // 120 ms at 115200 baud): hold each GGA until the GST of its time, so the fix carries its own
+  // epoch's accuracy. Off by default: the fix keeps the GGA's read stamp and would reach the
+  // estimator that much late, which refuses fixes older than its filter time unless
+  // estimation.imu_delay_s covers the wait. Offline decoding can turn it on.
+  bool wait_for_gst = false;
 };
 
 // Combines the sentences of one NMEA epoch into a GnssFix. The fix is emitted on GGA, with the
 // covariance of the latest GST (same UTC time, or not older than gst_max_age_s), the velocity
 // of an RMC with the same UTC time or a VTG received since the previous GGA, and the UTC time of
 // GGA on the date of the latest RMC (a day later or earlier when GGA's time of day wrapped).
-// Receivers that send GST after GGA (u-blox, ST Teseo) are learned from their first epoch: from
-// then on GGA is held until the GST of its time (a VTG in between gives the velocity), or is
-// emitted with the older accuracy when a sentence of the next epoch comes first.
+// With `wait_for_gst`, a receiver that sends GST after GGA is learned from its first epoch:
+// from then on GGA is held until the GST of its time (a VTG in between gives the velocity), or
+// is emitted with the older accuracy when a sentence of the next epoch comes first.
 class GnssFixBuilder {
  public:
   explicit GnssFixBuilder(const GnssFixBuilderConfig& config = {});
