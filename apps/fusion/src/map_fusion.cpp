@@ -1,5 +1,6 @@
 #include "semap/fusion/map_fusion.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 #include <unordered_set>
@@ -27,7 +28,7 @@ MapFusion::MapFusion(const dds_idl::Participant& participant, MapFusionConfig co
     : config_(std::move(config)),
       params_(layered_params(config_.description, config_.method, config_.prior)),
       fused_(params_),
-      publisher_(participant, config_.output, config_.description) {
+      publisher_(participant, config_.output, config_.description, *this) {
   if (config_.robots.empty()) throw std::invalid_argument("MapFusion: no robots to follow");
   robots_.reserve(config_.robots.size());
   for (std::size_t i = 0; i < config_.robots.size(); ++i) {
@@ -92,12 +93,13 @@ std::size_t MapFusion::merge_changed() {
   }
   std::size_t handed = 0;
   for (const auto& key : touched) {
-    auto& version = versions_[key];
-    auto block = fused_snapshot(fused_, key, version + 1);
-    if (!block) continue;
-    ++version;
-    publisher_.update(std::move(*block));
-    ++handed;
+    const auto& layers = fused_.layers();
+    if (std::any_of(layers.begin(), layers.end(),
+                    [&](const auto& layer) { return layer.second.find_block(key) != nullptr; })) {
+      ++versions_[key];
+      publisher_.changed(key);
+      ++handed;
+    }
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -106,6 +108,18 @@ std::size_t MapFusion::merge_changed() {
   counters_.merge_seconds_total += seconds;
   counters_.merge_seconds_max = std::max(counters_.merge_seconds_max, seconds);
   return handed;
+}
+
+void MapFusion::for_each_block(const std::function<void(const common::BlockIndex&)>& f) const {
+  for (const common::BlockIndex& key : fused_.block_keys()) f(key);
+}
+
+bool MapFusion::read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const {
+  const auto version = versions_.find(index);
+  auto block = fused_snapshot(fused_, index, version == versions_.end() ? 0 : version->second);
+  if (!block) return false;
+  out = std::move(*block);
+  return true;
 }
 
 std::size_t MapFusion::spin_once(common::Stamp now) {
