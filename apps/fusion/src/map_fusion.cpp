@@ -7,7 +7,7 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/fusion/block_layers.hpp"
-#include "semap/fusion/incremental_merge.hpp"
+#include "semap/mapping/incremental_merge.hpp"
 
 namespace semap::fusion {
 
@@ -79,7 +79,8 @@ std::size_t MapFusion::merge_changed() {
     if (robot.changed.empty()) continue;
     std::unordered_set<common::BlockIndex, common::BlockIndexHash> targets;
     for (const auto& key : robot.changed) {
-      for (const auto& t : touched_blocks(key, params_, params_, robot.source.T_fused_robot)) {
+      for (const auto& t :
+           mapping::touched_blocks(key, params_, params_, robot.source.T_fused_robot)) {
         targets.insert(t);
       }
     }
@@ -87,7 +88,8 @@ std::size_t MapFusion::merge_changed() {
     // The same as mapping::merge_into of the robot's whole layer, but resampling only the fused
     // blocks the change reaches.
     const std::vector<common::BlockIndex> list(targets.begin(), targets.end());
-    remerge_blocks(fused_, robot.id, robot.layer, params_, list, robot.source.T_fused_robot);
+    mapping::remerge_blocks(fused_, robot.id, robot.layer, params_, list,
+                            robot.source.T_fused_robot);
     touched.insert(list.begin(), list.end());
     ++robot.counters.merges;
   }
