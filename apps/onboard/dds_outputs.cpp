@@ -23,16 +23,15 @@ DdsOutputs::DdsOutputs(const OnboardConfig& config, const dds_idl::BlockSource& 
                                                  config.dds.publish_hz, config.dds.cloud_hz},
                      describe_map(config), map_blocks) {}
 
-DdsOutputs::~DdsOutputs() { stop(); }
+// Only joins: the map view may be gone by now (stop() is what publishes the last changes).
+DdsOutputs::~DdsOutputs() { publisher_stage_.stop(); }
 
 void DdsOutputs::start() {
-  publisher_thread_ = std::jthread([this](std::stop_token stop) { run_publisher(stop); });
+  publisher_stage_.start([this](std::stop_token stop) { run_publisher(stop); });
 }
 
 void DdsOutputs::stop() {
-  if (!publisher_thread_.joinable()) return;
-  publisher_thread_.request_stop();
-  publisher_thread_.join();
+  if (!publisher_stage_.stop()) return;
   // The last changes go out now rather than at the next round.
   take_changed();
   map_publisher_.publish_changed(common::Stamp::now());
@@ -54,9 +53,8 @@ void DdsOutputs::take_changed() {
 }
 
 void DdsOutputs::update_counters() {
-  std::lock_guard lock(map_counters_mutex_);
-  map_counters_ = map_publisher_.counters();
-  map_pending_ = map_publisher_.pending();
+  publisher_stage_.figures() = {map_publisher_.counters(), map_publisher_.pending()};
+  publisher_stage_.share();
 }
 
 void DdsOutputs::run_publisher(std::stop_token stop) {
@@ -93,14 +91,10 @@ void DdsOutputs::publish_health(const dds_idl::HealthReport& report) {
   ++health_written_;
 }
 
-std::size_t DdsOutputs::map_pending() const {
-  std::lock_guard lock(map_counters_mutex_);
-  return map_pending_;
-}
+std::size_t DdsOutputs::map_pending() const { return publisher_stage_.stats().pending; }
 
 dds_idl::MapPublisherCounters DdsOutputs::map_counters() const {
-  std::lock_guard lock(map_counters_mutex_);
-  return map_counters_;
+  return publisher_stage_.stats().counters;
 }
 
 }  // namespace semap::onboard

@@ -15,6 +15,7 @@
 #include "semap/dds_idl/topic.hpp"
 #include "semap/dds_idl/types.hpp"
 #include "semap/dds_idl/writer.hpp"
+#include "stage_thread.hpp"
 
 namespace semap::onboard {
 
@@ -59,11 +60,12 @@ class DdsOutputs {
   dds_idl::MapPublisher map_publisher_;  // the publisher thread's
   std::mutex changed_mutex_;
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
-  mutable std::mutex map_counters_mutex_;
-  dds_idl::MapPublisherCounters map_counters_;
-  std::size_t map_pending_ = 0;
   std::uint64_t health_written_ = 0;  // main thread only
-  std::jthread publisher_thread_;
+  struct PublisherFigures {
+    dds_idl::MapPublisherCounters counters;
+    std::size_t pending = 0;
+  };
+  StageThread<PublisherFigures> publisher_stage_;  // last: joined before the publisher goes
 };
 
 }  // namespace semap::onboard

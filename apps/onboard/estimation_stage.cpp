@@ -25,20 +25,12 @@ EstimationStage::EstimationStage(const OnboardConfig& config,
 EstimationStage::~EstimationStage() { stop(); }
 
 void EstimationStage::start() {
-  thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+  stage_.start([this](std::stop_token stop) { run(stop); });
 }
 
-void EstimationStage::stop() {
-  if (thread_.joinable()) {
-    thread_.request_stop();
-    thread_.join();
-  }
-}
+void EstimationStage::stop() { stage_.stop(); }
 
-EstimationStageStats EstimationStage::stats() const {
-  std::lock_guard lock(stats_mutex_);
-  return shared_;
-}
+EstimationStageStats EstimationStage::stats() const { return stage_.stats(); }
 
 void EstimationStage::run(std::stop_token stop) {
   while (!stop.stop_requested()) {
@@ -63,12 +55,12 @@ bool EstimationStage::drain_sensors() {
   while (i < n_imu || g < n_gnss) {
     if (g < n_gnss && (i == n_imu || gnss_batch[g].stamp <= imu_batch[i].stamp)) {
       estimator_.add_gnss(gnss_batch[g++]);
-      ++local_.gnss_fixes;
+      ++stage_.figures().gnss_fixes;
     } else {
       last_imu_ = imu_batch[i];
       estimator_.add_imu(imu_batch[i++]);
-      ++local_.imu_samples;
-      if (local_.heading_settled) {
+      ++stage_.figures().imu_samples;
+      if (stage_.figures().heading_settled) {
         if (auto pose = estimator_.pose_at(estimator_.filter_time())) new_poses_.push_back(*pose);
       }
     }
@@ -89,14 +81,14 @@ bool EstimationStage::drain_sensors() {
 // The yaw variance needs the covariance, which the InEKF forms on demand: ten checks per
 // second of filter time until the heading has settled once.
 void EstimationStage::check_heading() {
-  if (local_.heading_settled || !estimator_.initialised()) return;
+  if (stage_.figures().heading_settled || !estimator_.initialised()) return;
   const common::Stamp now = estimator_.filter_time();
   if (now < next_heading_check_) return;
   next_heading_check_ = now + 0.1;
   const double yaw_sigma_deg =
       std::sqrt(estimator_.filter().rotation_covariance_world()(2, 2)) * 180.0 / std::numbers::pi;
   if (yaw_sigma_deg > config_.map_start_heading_sigma_deg) return;
-  local_.heading_settled = now;
+  stage_.figures().heading_settled = now;
   common::logger("estimation")
       ->info("heading settled (sigma {:.2f} deg): camera frames are mapped from now on",
              yaw_sigma_deg);
@@ -119,12 +111,12 @@ void EstimationStage::publish_pose() {
   out.position_covariance = filter.position_covariance_world();
   out.rotation_covariance = filter.rotation_covariance_world();
   pose_sink_(out);
-  ++local_.poses_published;
+  ++stage_.figures().poses_published;
 }
 
 void EstimationStage::share_stats() {
-  local_.initialised = estimator_.initialised();
-  local_.estimator = estimator_.counters();
+  stage_.figures().initialised = estimator_.initialised();
+  stage_.figures().estimator = estimator_.counters();
   if (estimator_.initialised()) {
     const estimation::NavState state = estimator_.filter().state();
     estimation::StampedPose p;
@@ -132,12 +124,11 @@ void EstimationStage::share_stats() {
     p.orientation = Eigen::Quaterniond(state.rotation);
     p.position = state.position;
     p.velocity = state.velocity;
-    local_.latest = p;
+    stage_.figures().latest = p;
   }
-  local_.anchor = estimator_.anchor();
-  local_.anchor_offset = estimator_.anchor_offset();
-  std::lock_guard lock(stats_mutex_);
-  shared_ = local_;
+  stage_.figures().anchor = estimator_.anchor();
+  stage_.figures().anchor_offset = estimator_.anchor_offset();
+  stage_.share();
 }
 
 }  // namespace semap::onboard

@@ -12,6 +12,7 @@
 #include "semap/common/spsc_ring.hpp"
 #include "semap/estimation/estimator.hpp"
 #include "shared_pose_history.hpp"
+#include "stage_thread.hpp"
 
 namespace semap::onboard {
 
@@ -73,11 +74,8 @@ class EstimationStage {
   common::Stamp next_heading_check_;
   common::ImuSample last_imu_;
   common::Stamp next_pose_publish_;
-  EstimationStageStats local_;
-  mutable std::mutex stats_mutex_;
-  EstimationStageStats shared_;
   LatencyWindow imu_latency_;
-  std::jthread thread_;
+  StageThread<EstimationStageStats> stage_;  // last: joined before the members it uses
 };
 
 }  // namespace semap::onboard

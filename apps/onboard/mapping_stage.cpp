@@ -69,27 +69,22 @@ MappingStage::MappingStage(const OnboardConfig& config,
     pager_ =
         std::make_unique<mapping::MapPager>(map_, checkpoint_->log(), config.map_memory_radius_m);
   }
-  local_.checkpoint = checkpoint_->stats();
-  local_.map = map_.stats();
-  shared_ = local_;
+  stage_.figures().checkpoint = checkpoint_->stats();
+  stage_.figures().map = map_.stats();
+  stage_.share();
 }
 
 MappingStage::~MappingStage() { stop(); }
 
 void MappingStage::start() {
-  thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+  stage_.start([this](std::stop_token stop) { run(stop); });
 }
 
 void MappingStage::stop() {
-  if (thread_.joinable()) {
-    thread_.request_stop();
-    thread_.join();
-    if (checkpoint_) {
-      checkpoint_->flush();
-      local_.checkpoint = checkpoint_->stats();
-      std::lock_guard lock(stats_mutex_);
-      shared_ = local_;
-    }
+  if (stage_.stop() && checkpoint_) {
+    checkpoint_->flush();
+    stage_.figures().checkpoint = checkpoint_->stats();
+    stage_.share();
   }
 }
 
@@ -106,10 +101,7 @@ const mapping::SemanticMap& MappingStage::map() {
   return *full_map_;
 }
 
-MappingStageStats MappingStage::stats() const {
-  std::lock_guard lock(stats_mutex_);
-  return shared_;
-}
+MappingStageStats MappingStage::stats() const { return stage_.stats(); }
 
 void MappingStage::run(std::stop_token stop) {
   tbb::task_arena arena(config_.map_threads);
@@ -150,17 +142,16 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
-  local_.scans++;
-  local_.points += cloud.size();
-  local_.blocks_changed += result.updated_blocks.size();
-  local_.insert_seconds_total += seconds;
-  local_.insert_seconds_max = std::max(local_.insert_seconds_max, seconds);
-  local_.map = map_.stats();
-  if (checkpoint_) local_.checkpoint = checkpoint_->stats();
-  if (pager_) local_.pager = pager_->stats();
+  stage_.figures().scans++;
+  stage_.figures().points += cloud.size();
+  stage_.figures().blocks_changed += result.updated_blocks.size();
+  stage_.figures().insert_seconds_total += seconds;
+  stage_.figures().insert_seconds_max = std::max(stage_.figures().insert_seconds_max, seconds);
+  stage_.figures().map = map_.stats();
+  if (checkpoint_) stage_.figures().checkpoint = checkpoint_->stats();
+  if (pager_) stage_.figures().pager = pager_->stats();
   if (sink_) sink_(result.updated_blocks);
-  std::lock_guard lock(stats_mutex_);
-  shared_ = local_;
+  stage_.share();
 }
 
 void MappingStage::for_each_block(const std::function<void(const common::BlockIndex&)>& f) const {

@@ -18,6 +18,7 @@
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/mapping/map_checkpoint.hpp"
 #include "semap/mapping/semantic_map.hpp"
+#include "stage_thread.hpp"
 
 namespace semap::onboard {
 
@@ -87,11 +88,8 @@ class MappingStage : private dds_idl::BlockSource {
   std::unique_ptr<mapping::MapPager> pager_;
   std::unique_ptr<mapping::SemanticMap> full_map_;  // map() with a pager
   std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
-  MappingStageStats local_;
-  mutable std::mutex stats_mutex_;
-  MappingStageStats shared_;
   LatencyWindow latency_;
-  std::jthread thread_;
+  StageThread<MappingStageStats> stage_;  // last: joined before the members it uses
 };
 
 // The map's shape and its palette's class names and colours (0xRRGGBB), for MapInfo.

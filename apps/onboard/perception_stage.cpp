@@ -62,20 +62,12 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
 PerceptionStage::~PerceptionStage() { stop(); }
 
 void PerceptionStage::start() {
-  thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+  stage_.start([this](std::stop_token stop) { run(stop); });
 }
 
-void PerceptionStage::stop() {
-  if (thread_.joinable()) {
-    thread_.request_stop();
-    thread_.join();
-  }
-}
+void PerceptionStage::stop() { stage_.stop(); }
 
-PerceptionStageStats PerceptionStage::stats() const {
-  std::lock_guard lock(stats_mutex_);
-  return shared_;
-}
+PerceptionStageStats PerceptionStage::stats() const { return stage_.stats(); }
 
 std::uint32_t PerceptionStage::queue_depth() const {
   const std::size_t depth = depth_ring_ ? depth_ring_->size() : 0;
@@ -108,7 +100,7 @@ bool PerceptionStage::take_frames() {
   common::ImageFrame frame;
   while (colour_ring_.try_pop(frame)) {
     colour_pending_.push_back(std::move(frame));
-    ++local_.frames;
+    ++stage_.figures().frames;
     any = true;
   }
   while (depth_ring_ && depth_ring_->try_pop(frame)) {
@@ -124,7 +116,7 @@ bool PerceptionStage::take_frames() {
 bool PerceptionStage::process_next() {
   if (colour_pending_.empty()) return false;
   if (depth_.source != DepthSource::kAligned) {
-    local_.skipped += colour_pending_.size() - 1;
+    stage_.figures().skipped += colour_pending_.size() - 1;
     const common::ImageFrame colour = std::move(colour_pending_.back());
     colour_pending_.clear();
     process(colour, nullptr);
@@ -144,13 +136,13 @@ bool PerceptionStage::process_next() {
     }
     if (best == depth_pending_.end()) continue;
     const auto index = static_cast<std::size_t>(colour_pending_.rend() - c) - 1;
-    local_.skipped += index;
+    stage_.figures().skipped += index;
     const common::ImageFrame colour = std::move(*c);
     const common::ImageFrame depth = std::move(*best);
     colour_pending_.erase(colour_pending_.begin(),
                           colour_pending_.begin() + static_cast<std::ptrdiff_t>(index) + 1);
     // Depth frames before the partner are too old for any later colour frame.
-    local_.depth_unused += static_cast<std::uint64_t>(best - depth_pending_.begin());
+    stage_.figures().depth_unused += static_cast<std::uint64_t>(best - depth_pending_.begin());
     depth_pending_.erase(depth_pending_.begin(), best + 1);
     process(colour, &depth);
     return true;
@@ -165,27 +157,27 @@ bool PerceptionStage::process_next() {
       ++count;
     }
   };
-  expire(colour_pending_, depth_pending_, local_.unpaired);
-  expire(depth_pending_, colour_pending_, local_.depth_unused);
+  expire(colour_pending_, depth_pending_, stage_.figures().unpaired);
+  expire(depth_pending_, colour_pending_, stage_.figures().depth_unused);
   // A depth device that stopped delivering must not let colour frames pile up.
   while (colour_pending_.size() > colour_ring_.capacity()) {
     colour_pending_.pop_front();
-    ++local_.unpaired;
+    ++stage_.figures().unpaired;
   }
   while (depth_pending_.size() > depth_ring_->capacity()) {
     depth_pending_.pop_front();
-    ++local_.depth_unused;
+    ++stage_.figures().depth_unused;
   }
   return false;
 }
 
 void PerceptionStage::reject(const common::ImageFrame& frame, const std::string& why) {
-  ++local_.bad_frames;
+  ++stage_.figures().bad_frames;
   // One line per bad frame would flood the log at camera rates: the first few and then every
   // hundredth, each with its count.
-  if (local_.bad_frames <= 5 || local_.bad_frames % 100 == 0) {
+  if (stage_.figures().bad_frames <= 5 || stage_.figures().bad_frames % 100 == 0) {
     common::logger("perception")
-        ->warn("{} rejected ({} so far): {}", frame_name(frame), local_.bad_frames, why);
+        ->warn("{} rejected ({} so far): {}", frame_name(frame), stage_.figures().bad_frames, why);
   }
 }
 
@@ -217,16 +209,17 @@ void PerceptionStage::process(const common::ImageFrame& colour, const common::Im
     const perception::Segmentation segmentation = segmenter_->segment(image);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    local_.segment_seconds_total += seconds;
-    local_.segment_seconds_max = std::max(local_.segment_seconds_max, seconds);
+    stage_.figures().segment_seconds_total += seconds;
+    stage_.figures().segment_seconds_max = std::max(stage_.figures().segment_seconds_max, seconds);
     if (observer_) observer_(colour.sequence, colour.stamp, image, segmentation);
-    BodyCloud body{perception::cloud_from_depth(depth_m, segmentation, intrinsics,
-                                                body_from_optical, depth_.points, local_.dropped),
-                   colour.sequence};
+    BodyCloud body{
+        perception::cloud_from_depth(depth_m, segmentation, intrinsics, body_from_optical,
+                                     depth_.points, stage_.figures().dropped),
+        colour.sequence};
     body.cloud.stamp = colour.stamp;
     if (unposed_.size() == kMaxUnposed) {
       unposed_.pop_front();  // the filter has stalled; keep the newest
-      ++local_.without_pose;
+      ++stage_.figures().without_pose;
     }
     unposed_.push_back(std::move(body));
   } catch (const std::exception& e) {
@@ -241,24 +234,21 @@ bool PerceptionStage::pose_clouds() {
     if (lookup.status == SharedPoseHistory::Status::kPending) break;
     any = true;
     if (lookup.status != SharedPoseHistory::Status::kPosed) {
-      ++local_.without_pose;
+      ++stage_.figures().without_pose;
       unposed_.pop_front();
       continue;
     }
     common::LabeledCloud cloud = to_world(std::move(unposed_.front().cloud), lookup.pose);
     const common::Stamp stamp = cloud.stamp;
-    local_.points += cloud.size();
+    stage_.figures().points += cloud.size();
     unposed_.pop_front();
     cloud_ring_.try_push(std::move(cloud));  // drop-oldest: the ring counts what it drops
-    ++local_.clouds;
+    ++stage_.figures().clouds;
     latency_.record(common::seconds_between(common::Stamp::now(), stamp));
   }
   return any;
 }
 
-void PerceptionStage::share_stats() {
-  std::lock_guard lock(stats_mutex_);
-  shared_ = local_;
-}
+void PerceptionStage::share_stats() { stage_.share(); }
 
 }  // namespace semap::onboard

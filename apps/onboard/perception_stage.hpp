@@ -14,6 +14,7 @@
 #include "semap/perception/labelled_points.hpp"
 #include "semap/perception/segmentation.hpp"
 #include "shared_pose_history.hpp"
+#include "stage_thread.hpp"
 
 namespace semap::perception {
 class StereoDepth;
@@ -102,11 +103,8 @@ class PerceptionStage {
   std::deque<common::ImageFrame> colour_pending_;
   std::deque<common::ImageFrame> depth_pending_;
   std::deque<BodyCloud> unposed_;
-  PerceptionStageStats local_;
-  mutable std::mutex stats_mutex_;
-  PerceptionStageStats shared_;
   LatencyWindow latency_;
-  std::jthread thread_;
+  StageThread<PerceptionStageStats> stage_;  // last: joined before the members it uses
 };
 
 // A body-frame cloud in the world frame, with the robot at `pose`.
