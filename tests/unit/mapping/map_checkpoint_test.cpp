@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <thread>
 
@@ -15,13 +16,32 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Not named by the process: a death test's child process (re-executed) must find the same one.
 fs::path scratch_dir(const std::string& name) {
   const fs::path dir =
-      fs::temp_directory_path() / ("semap_checkpoint_" + std::to_string(::getuid()) + "_" + name);
+      fs::temp_directory_path() / ("semap_checkpoint_" + std::to_string(::getpid()) + "_" + name);
   fs::create_directories(dir);
   return dir;
 }
+
+// The directory a death test shares with its child (the same binary, re-executed, which
+// inherits the environment), removed with the variable at the end of the test.
+class SharedDir {
+ public:
+  explicit SharedDir(const std::string& name) {
+    const char* inherited = std::getenv(kVariable);
+    dir_ = inherited != nullptr ? fs::path(inherited) : scratch_dir(name);
+    ::setenv(kVariable, dir_.c_str(), 1);
+  }
+  ~SharedDir() {
+    ::unsetenv(kVariable);
+    fs::remove_all(dir_);
+  }
+  const fs::path& path() const { return dir_; }
+
+ private:
+  static constexpr const char* kVariable = "SEMAP_CHECKPOINT_TEST_DIR";
+  fs::path dir_;
+};
 
 // Bit-for-bit equality of the blocks in memory.
 void expect_same_map(const SemanticMap& a, const SemanticMap& b) {
@@ -62,8 +82,8 @@ class KilledRobot : public ::testing::TestWithParam<bool> {};
 TEST_P(KilledRobot, ResumesTheMapOfItsLastCheckpointExactly) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   const bool let_writer_finish = GetParam();
-  const fs::path dir = scratch_dir(let_writer_finish ? "settled" : "racing");
-  fs::remove(dir / "map.log");  // the child re-runs this line before it starts mapping
+  const SharedDir shared(let_writer_finish ? "settled" : "racing");
+  const fs::path& dir = shared.path();
   constexpr int kScans = 9;
   EXPECT_EXIT(map_then_get_killed(dir / "map.log", kScans, let_writer_finish),
               ::testing::KilledBySignal(SIGKILL), "");
@@ -85,7 +105,6 @@ TEST_P(KilledRobot, ResumesTheMapOfItsLastCheckpointExactly) {
     reference.insert(cloud, cloud.origin);
   }
   expect_same_map(reference, resumed);
-  fs::remove_all(dir);
 }
 
 INSTANTIATE_TEST_SUITE_P(Timing, KilledRobot, ::testing::Values(true, false),
@@ -117,7 +136,6 @@ common::LabeledCloud street_scan(float x) {
 // entirely in memory.
 TEST(MapPager, LongDriveStaysBoundedAndLosesNothing) {
   const fs::path dir = scratch_dir("drive");
-  fs::remove(dir / "map.log");
   MapParams params;
   params.resolution = 0.2f;
   params.max_range = 8.0f;
