@@ -1,12 +1,14 @@
-#include "semap/mapping/pcd_io.hpp"
+#include "semap/map_io/pcd_io.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <functional>
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
+
+using namespace semap::mapping;
 
 std::string error_of(const std::function<void()>& f) {
   try {
@@ -108,4 +110,4 @@ TEST(PcdIo, TruncatedBinaryDataIsAnError) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io

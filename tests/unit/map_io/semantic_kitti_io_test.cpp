@@ -1,12 +1,14 @@
-#include "semap/mapping/semantic_kitti_io.hpp"
+#include "semap/map_io/semantic_kitti_io.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
+
+using namespace semap::mapping;
 
 namespace fs = std::filesystem;
 
@@ -86,4 +88,4 @@ TEST_F(KittiFiles, MalformedFilesNameFileAndLine) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io
