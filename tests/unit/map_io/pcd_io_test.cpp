@@ -8,8 +8,6 @@
 namespace semap::map_io {
 namespace {
 
-using namespace semap::mapping;
-
 std::string error_of(const std::function<void()>& f) {
   try {
     f();

@@ -8,8 +8,6 @@
 namespace semap::map_io {
 namespace {
 
-using namespace semap::mapping;
-
 namespace fs = std::filesystem;
 
 // Writes a two-scan sequence in the SemanticKITTI layout.
