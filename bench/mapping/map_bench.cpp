@@ -103,8 +103,13 @@ void add_phases(semap::mapping::InsertPhases& sum, const semap::mapping::InsertP
 
 // How the 12 scans go in: one insert(cloud, origin) per scan, its training-set build timed
 // apart, or one batch insert(clouds, origins) that builds the next scans' training sets while
-// the current one is fused.
-enum class ToyPath { kScan, kBatch };
+// the current one is fused; kPlain is the scan path with the plain engine (bki_update.hpp), the
+// paper's update one point and cell at a time, that the tiled engine is measured against.
+enum class ToyPath { kScan, kBatch, kPlain };
+
+const char* to_string(ToyPath path) {
+  return path == ToyPath::kScan ? "scan" : path == ToyPath::kBatch ? "batch" : "plain";
+}
 
 ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, ToyPath path,
                    int repetitions) {
@@ -112,13 +117,15 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, ToyPa
   for (const auto& c : clouds) origins.push_back(c.origin);
   ToyTiming t;
   for (int r = 0; r < repetitions; ++r) {
-    SemanticMap map(toy_params(method));
+    MapParams params = toy_params(method);
+    if (path == ToyPath::kPlain) params.engine = semap::mapping::Engine::kPlain;
+    SemanticMap map(params);
     double training = -1;
     std::size_t points = 0;
     semap::mapping::InsertPhases phases;
     const double cpu0 = process_cpu_seconds();
     const auto start = Clock::now();
-    if (path == ToyPath::kScan) {
+    if (path != ToyPath::kBatch) {
       training = 0;
       for (const auto& c : clouds) {
         const auto t0 = Clock::now();
@@ -143,7 +150,7 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, ToyPa
       t.stats = map.stats();
       t.checksum = map_checksum(map);
       t.phases = phases;
-      if (path == ToyPath::kScan) t.phases.training = training;
+      if (path != ToyPath::kBatch) t.phases.training = training;
     }
   }
   return t;
@@ -162,20 +169,22 @@ void toy_figures(int repetitions) {
     for (const int threads : {1, 2}) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
                                 static_cast<std::size_t>(threads));
-      for (const ToyPath path : {ToyPath::kScan, ToyPath::kBatch}) {
+      for (const ToyPath path : {ToyPath::kScan, ToyPath::kBatch, ToyPath::kPlain}) {
+        // The plain engine runs on one thread whatever the limit.
+        if (path == ToyPath::kPlain && threads != 1) continue;
         const ToyTiming t = time_toy(clouds, method, path, repetitions);
         // Reference S-BKI: 0.38 s on one thread, 0.21 s on two (OpenMP).
         const double ref = threads == 1 ? 0.38 : 0.21;
         char training[32] = "-";
         if (t.training >= 0) std::snprintf(training, sizeof training, "%.2f", t.training * 1e3);
         std::printf("%-5s %-8d %-6s %10.2f %10.2f %10s %10zu %8.1fx %8.2f  %016llx\n",
-                    semap::mapping::to_string(method).c_str(), threads,
-                    path == ToyPath::kScan ? "scan" : "batch", t.best_total * 1e3, t.cpu * 1e3,
-                    training, t.training_points, ref / t.best_total, t.stats.bytes_per_cell(),
+                    semap::mapping::to_string(method).c_str(), threads, to_string(path),
+                    t.best_total * 1e3, t.cpu * 1e3, training, t.training_points,
+                    ref / t.best_total, t.stats.bytes_per_cell(),
                     static_cast<unsigned long long>(t.checksum));
         char row[32];
         std::snprintf(row, sizeof row, "%-5s %-8d %-6s", semap::mapping::to_string(method).c_str(),
-                      threads, path == ToyPath::kScan ? "scan" : "batch");
+                      threads, to_string(path));
         phases.emplace_back(row, t.phases);
       }
     }
@@ -211,6 +220,7 @@ void lidar_figures(int scans) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
   SemanticMap map(p);
   std::vector<double> times;
+  std::vector<double> fusion_times;  // insert(training set) alone
   std::size_t points = 0, training = 0;
   double cpu = 0, training_seconds = 0;
   for (int s = 0; s < scans; ++s) {
@@ -220,9 +230,11 @@ void lidar_figures(int scans) {
     const auto start = Clock::now();
     // The same two steps as map.insert(cloud, origin), timed apart.
     const auto set = semap::mapping::build_training_set(cloud, cloud.origin, map.params());
-    training_seconds += seconds_since(start);
+    const double built = seconds_since(start);
+    training_seconds += built;
     training += map.insert(set).training_points;
     times.push_back(seconds_since(start));
+    fusion_times.push_back(times.back() - built);
     cpu += process_cpu_seconds() - cpu0;
   }
   std::vector<double> sorted = times;
@@ -241,6 +253,28 @@ void lidar_figures(int scans) {
               cpu / scans * 1e3, training_seconds / scans * 1e3);
   std::printf("blocks %zu  cells %zu  observed %zu  bytes/cell %.2f (target <= %d)\n", stats.blocks,
               stats.cells, stats.observed_cells, stats.bytes_per_cell(), 4 * p.num_classes + 16);
+  // The baseline: the plain engine on the first scans (its training sets built outside the
+  // timing), median per scan.
+  constexpr int kPlainScans = 5;
+  MapParams plain_params = p;
+  plain_params.engine = semap::mapping::Engine::kPlain;
+  SemanticMap plain(plain_params);
+  std::vector<double> plain_times;
+  for (int s = 0; s < std::min(scans, kPlainScans); ++s) {
+    const LabeledCloud cloud = lidar.scan(s);
+    const auto set = semap::mapping::build_training_set(cloud, cloud.origin, plain.params());
+    const auto start = Clock::now();
+    plain.insert(set);
+    plain_times.push_back(seconds_since(start));
+  }
+  std::sort(plain_times.begin(), plain_times.end());
+  std::sort(fusion_times.begin(), fusion_times.end());
+  const double plain_median = plain_times[plain_times.size() / 2];
+  const double fusion_median = fusion_times[fusion_times.size() / 2];
+  std::printf(
+      "fusion only, median per scan: tiled %.1f ms (2 threads), plain %.1f ms (one thread, "
+      "first %zu scans): tiled %.1fx faster\n",
+      fusion_median * 1e3, plain_median * 1e3, plain_times.size(), plain_median / fusion_median);
 }
 
 }  // namespace

@@ -39,6 +39,20 @@ int Block::num_observed() const {
   return count;
 }
 
+std::span<const std::uint64_t> Block::observed_words() const {
+  return {observed_.get(), words_for(num_cells())};
+}
+
+void Block::restore(std::span<const float> evidence, std::span<const std::uint64_t> observed) {
+  if (observed.size() != words_for(num_cells())) {
+    throw std::invalid_argument("block has " + std::to_string(observed.size()) +
+                                " observed words, expected " +
+                                std::to_string(words_for(num_cells())));
+  }
+  add_evidence(evidence);
+  for (std::size_t w = 0; w < observed.size(); ++w) observed_[w] |= observed[w];
+}
+
 void Block::add_evidence(std::span<const float> evidence) {
   if (evidence.size() != static_cast<std::size_t>(num_cells()) * k_) {
     throw std::invalid_argument("block evidence has " + std::to_string(evidence.size()) +

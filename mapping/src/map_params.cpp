@@ -13,6 +13,14 @@ Method method_from_string(const std::string& name) {
 
 std::string to_string(Method method) { return method == Method::kBki ? "bki" : "csm"; }
 
+Engine engine_from_string(const std::string& name) {
+  if (name == "tiled") return Engine::kTiled;
+  if (name == "plain") return Engine::kPlain;
+  throw std::invalid_argument("unknown map engine '" + name + "' (expected tiled or plain)");
+}
+
+std::string to_string(Engine engine) { return engine == Engine::kTiled ? "tiled" : "plain"; }
+
 void MapParams::validate() const {
   auto positive = [](float v, const char* name) {
     if (!(std::isfinite(v) && v > 0.0f)) {
@@ -54,6 +62,7 @@ MapParams map_params_from_config(const common::ConfigSection& s, const MapParams
   p.max_range = static_cast<float>(s.get_in_range("max_range", p.max_range, -1.0, 1e6));
   p.unknown_variance =
       static_cast<float>(s.get_in_range("unknown_variance", p.unknown_variance, 0.0, 1.0));
+  p.engine = engine_from_string(s.get_choice("engine", to_string(p.engine), {"tiled", "plain"}));
   p.validate();
   return p;
 }

@@ -4,6 +4,7 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "semap/mapping/bki_update.hpp"
 #include "semap/mapping/voxel_hash_map.hpp"
 #include "tile_inserter.hpp"
 
@@ -26,8 +28,7 @@ constexpr std::size_t kAllocOverhead = 16;
 
 SemanticMap::SemanticMap(const MapParams& params)
     : params_(params),
-      kernel_((params.validate(), SparseKernel(params.sf2, params.ell))),
-      inserter_(std::make_unique<detail::TileInserter>(params)) {}
+      inserter_((params.validate(), std::make_unique<detail::TileInserter>(params))) {}
 
 SemanticMap::~SemanticMap() = default;
 SemanticMap::SemanticMap(SemanticMap&&) noexcept = default;
@@ -98,7 +99,9 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
                 if (!spare.try_pop(prepared)) prepared = std::make_shared<Prepared>();
                 try {
                   prepared->timed = build_timed(clouds[scan], origins[scan], params_);
-                  inserter_->plan(prepared->timed.training, prepared->plan);
+                  if (params_.engine == Engine::kTiled) {
+                    inserter_->plan(prepared->timed.training, prepared->plan);
+                  }
                 } catch (...) {
                   prepared->error = std::current_exception();
                 }
@@ -107,7 +110,9 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
           tbb::make_filter<std::shared_ptr<Prepared>, void>(
               tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Prepared>& prepared) {
                 if (prepared->error) std::rethrow_exception(prepared->error);
-                results.push_back(fuse_scan(prepared->timed.training, &prepared->plan));
+                results.push_back(
+                    fuse_scan(prepared->timed.training,
+                              params_.engine == Engine::kTiled ? &prepared->plan : nullptr));
                 results.back().phases.training = prepared->timed.seconds;
                 spare.push(prepared);
               }));
@@ -132,17 +137,25 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
   InsertResult result;
   result.training_points = training.size();
   result.hits = training.num_hits;
-  const auto block_at = [this](const common::BlockIndex& index) -> Block& {
+  const BlockAt block_at = [this](const common::BlockIndex& index) -> Block& {
     return this->block_at(index);
   };
-  detail::TileInsertResult fused = plan != nullptr
-                                       ? inserter_->apply(*plan, training, kernel_, block_at)
-                                       : inserter_->insert(training, kernel_, block_at);
-  result.rejected_points = fused.rejected_points;
-  rejected_ += fused.rejected_points;
-  result.blocks_updated = fused.updated_blocks.size();
-  result.phases = fused.phases;
-  result.updated_blocks = std::move(fused.updated_blocks);
+  if (params_.engine == Engine::kPlain) {
+    const auto start = std::chrono::steady_clock::now();
+    UpdateResult updated = plain_update(training, params_, block_at);
+    result.phases.scatter =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.rejected_points = updated.rejected_points;
+    result.updated_blocks = std::move(updated.updated_blocks);
+  } else {
+    detail::TileInsertResult fused = plan != nullptr ? inserter_->apply(*plan, training, block_at)
+                                                     : inserter_->insert(training, block_at);
+    result.rejected_points = fused.rejected_points;
+    result.phases = fused.phases;
+    result.updated_blocks = std::move(fused.updated_blocks);
+  }
+  rejected_ += result.rejected_points;
+  result.blocks_updated = result.updated_blocks.size();
   ++scans_;
   return result;
 }
@@ -175,20 +188,52 @@ int SemanticMap::label_at(const Eigen::Vector3f& point) const {
 const Block* SemanticMap::find_block(const common::BlockIndex& index) const {
   if (!VoxelHashMap::in_range(index)) return nullptr;
   const std::uint32_t id = table_.find(index);
-  return id == VoxelHashMap::kNone ? nullptr : &blocks_[id];
+  return id == VoxelHashMap::kNone || !resident_[id] ? nullptr : &blocks_[id];
 }
 
 Block& SemanticMap::block_at(const common::BlockIndex& index) {
   const std::uint32_t id = table_.insert(index);
   if (id == blocks_.size()) {
     indices_.push_back(index);
-    const auto floats = static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
-    blocks_.emplace_back(params_.cells_per_side(), params_.num_classes, arena_.allocate(floats));
+    blocks_.emplace_back(params_.cells_per_side(), params_.num_classes, new_storage());
+    resident_.push_back(1);
+  } else if (!resident_[id]) {
+    blocks_[id] = Block(params_.cells_per_side(), params_.num_classes, new_storage());
+    resident_[id] = 1;
+    --evicted_;
   }
   return blocks_[id];
 }
 
-void SemanticMap::add_evidence(const common::BlockIndex& index, std::span<const float> evidence) {
+float* SemanticMap::new_storage() {
+  const auto floats = static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
+  if (spare_storage_.empty()) return arena_.allocate(floats);
+  float* storage = spare_storage_.back();
+  spare_storage_.pop_back();
+  std::fill_n(storage, floats, 0.0f);
+  return storage;
+}
+
+bool SemanticMap::evict(const common::BlockIndex& index) {
+  if (!VoxelHashMap::in_range(index)) return false;
+  const std::uint32_t id = table_.find(index);
+  if (id == VoxelHashMap::kNone || !resident_[id]) return false;
+  spare_storage_.push_back(blocks_[id].cell_evidence_mutable(0));
+  // A block without storage: never read while it is not resident.
+  blocks_[id] = Block(params_.cells_per_side(), params_.num_classes, nullptr);
+  resident_[id] = 0;
+  ++evicted_;
+  return true;
+}
+
+void SemanticMap::restore_block(const common::BlockIndex& index, std::span<const float> evidence,
+                                std::span<const std::uint64_t> observed) {
+  check_block_evidence(index, evidence);
+  block_at(index).restore(evidence, observed);
+}
+
+void SemanticMap::check_block_evidence(const common::BlockIndex& index,
+                                       std::span<const float> evidence) const {
   if (!VoxelHashMap::in_range(index)) {
     throw std::invalid_argument("block index beyond the map's +-2^20 range");
   }
@@ -198,26 +243,31 @@ void SemanticMap::add_evidence(const common::BlockIndex& index, std::span<const 
     throw std::invalid_argument("block evidence has " + std::to_string(evidence.size()) +
                                 " floats, expected " + std::to_string(expected));
   }
+}
+
+void SemanticMap::add_evidence(const common::BlockIndex& index, std::span<const float> evidence) {
+  check_block_evidence(index, evidence);
   block_at(index).add_evidence(evidence);
 }
 
 MapStats SemanticMap::stats() const {
   MapStats s;
-  s.blocks = blocks_.size();
+  s.blocks = blocks_.size() - evicted_;
+  s.evicted_blocks = evicted_;
   s.scans = scans_;
   s.rejected_points = rejected_;
   // Table, index list and the deque's slots, then every block with its two heap arrays.
   s.bytes = table_.bytes() + indices_.capacity() * sizeof(common::BlockIndex) +
             blocks_.size() * sizeof(Block);
   std::size_t evidence_bytes = 0;
-  for (const Block& block : blocks_) {
+  for_each_block([&](const common::BlockIndex&, const Block& block) {
     s.cells += static_cast<std::size_t>(block.num_cells());
     s.observed_cells += static_cast<std::size_t>(block.num_observed());
     // The observed bits are one heap allocation; the evidence lives in the arena.
     s.bytes += block.bytes() - sizeof(Block) + kAllocOverhead;
     evidence_bytes += block.evidence().size_bytes();
-  }
-  // The arena's alignment padding.
+  });
+  // The arena's alignment padding, and the storage of evicted blocks kept for reuse.
   s.bytes += arena_.bytes_used() - evidence_bytes;
   return s;
 }

@@ -15,6 +15,8 @@
 #include <cstring>
 #include <numeric>
 
+#include "kernel_lanes.hpp"
+
 namespace semap::mapping::detail {
 
 namespace {
@@ -127,6 +129,32 @@ constexpr std::size_t kBlocksPerTask = 16;
 // Points per parallel chunk of the per-point preparation.
 constexpr std::size_t kPointGrain = 1024;
 
+#if defined(__AVX2__)
+using RowKernel = KernelLanes;
+#else
+using RowKernel = KernelPolynomial;
+#endif
+
+// The kernel weights of one row of cells, 0 where mask (the cells inside the sphere) is clear:
+// w[x] = k(dyz2 + dx2[x]) for x < width <= 32. dx2 is readable up to width rounded up to 8.
+inline void row_weights(const float* dx2, std::int32_t width, float dyz2, std::uint32_t mask,
+                        const RowKernel& kernel, float* w) {
+#if defined(__AVX2__)
+  const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  for (std::int32_t x = 0; x < width; x += 8) {
+    const __m256i bits = _mm256_set1_epi32(static_cast<std::int32_t>((mask >> x) & 0xFFu));
+    const __m256 inside =
+        _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(bits, lane_bit), lane_bit));
+    const __m256 d2 = _mm256_add_ps(_mm256_set1_ps(dyz2), _mm256_loadu_ps(dx2 + x));
+    _mm256_storeu_ps(w + x, kernel8(d2, inside, kernel));
+  }
+#else
+  for (std::int32_t x = 0; x < width; ++x) {
+    w[x] = (mask >> x) & 1u ? kernel(dyz2 + dx2[x]) : 0.0f;
+  }
+#endif
+}
+
 // Adds k(d) y_i to every cell of the block-local `box` whose centre lies within ell of point
 // i and marks them observed. `d2[a][c]` is the squared distance along axis a to the centres
 // of local cell box.lo[a] + c (readable 8 floats past the box). Hard labels touch one float
@@ -134,16 +162,19 @@ constexpr std::size_t kPointGrain = 1024;
 template <bool kSoft>
 void smooth_point(Block& block, std::int32_t side, const CellBox& box,
                   const std::array<const float*, 3>& d2, const TrainingSet& training, std::size_t i,
-                  const KernelTable& kernel) {
+                  const KernelPolynomial& kernel) {
   const auto k = static_cast<std::size_t>(training.num_classes);
   const float ell2 = kernel.ell_squared();
   const float* y = kSoft ? training.probabilities.data() + i * k : nullptr;
   const std::int32_t width = box.hi[0] - box.lo[0] + 1;
   const float* dx2 = d2[0];
-  // A copy in registers: the stores below would otherwise make the compiler reload the
-  // table's pointer for every cell.
-  const KernelTable::View lut = kernel.view();
   const std::size_t row_stride = static_cast<std::size_t>(side) * k;
+  alignas(32) std::array<float, 32 + 8> w;
+#if defined(__AVX2__)
+  const KernelLanes row_kernel(kernel);
+#else
+  const KernelPolynomial& row_kernel = kernel;
+#endif
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
     const float dz2 = d2[2][z - box.lo[2]];
     // Rows whose centre line passes within ell: again one run, found without branches. At
@@ -158,26 +189,22 @@ void smooth_point(Block& block, std::int32_t side, const CellBox& box,
                    static_cast<std::size_t>(y_first) * row_stride;
     for (std::int32_t yy = y_first; yy <= y_last; ++yy, cells += row_stride) {
       const float dyz2 = dz2 + d2[1][yy];
-      // x is inside when d2x < ell^2 - dyz2; its weight is the tabulated kernel of
-      // dyz2 + d2x. The inside cells are one run (d2x is convex in x).
-      const float rest = ell2 - dyz2;
-      const std::uint32_t mask = inside_mask(dx2, width, rest);
+      // x is inside when d2x < ell^2 - dyz2; the inside cells are one run (d2x is convex).
+      const std::uint32_t mask = inside_mask(dx2, width, ell2 - dyz2);
       if (mask == 0) continue;
-      const std::int32_t x_lo = std::countr_zero(mask);
-      const std::int32_t x_hi = 31 - std::countl_zero(mask);
+      row_weights(dx2, width, dyz2, mask, row_kernel, w.data());
       if constexpr (kSoft) {
-        for (std::int32_t x = x_lo; x <= x_hi; ++x) {
-          const float w = lut.inside(dyz2 + dx2[x]);
+        const std::int32_t x_hi = 31 - std::countl_zero(mask);
+        for (std::int32_t x = std::countr_zero(mask); x <= x_hi; ++x) {
           float* alpha = cells + static_cast<std::size_t>(x) * k;
-          for (std::size_t c = 0; c < k; ++c) alpha[c] += w * y[c];
+          for (std::size_t c = 0; c < k; ++c) alpha[c] += w[static_cast<std::size_t>(x)] * y[c];
         }
       } else {
-        // Every cell of the row, outside ones weighted 0: the trip count is the same for all
+        // Every cell of the row, outside ones adding 0: the trip count is the same for all
         // rows of a piece, so the loop exit is predicted (a run's length is not).
         float* column = cells + training.labels[i];
         for (std::int32_t x = 0; x < width; ++x) {
-          const float inside = static_cast<float>((mask >> x) & 1u);
-          column[static_cast<std::size_t>(x) * k] += lut.clamped(dyz2 + dx2[x]) * inside;
+          column[static_cast<std::size_t>(x) * k] += w[static_cast<std::size_t>(x)];
         }
       }
       // A row of side <= 32 cells starts at a multiple of side, so it lies in one 64-bit word.
@@ -427,7 +454,7 @@ inline Piece TileInserter::piece_of(const TilePlan& plan, std::size_t i,
 
 void TileInserter::scatter_in_place(const TilePlan& plan, Block& block,
                                     const std::array<std::int32_t, 3>& base, std::size_t i,
-                                    const TrainingSet& training, const KernelTable& kernel) const {
+                                    const TrainingSet& training) const {
   const std::int32_t side = 1 << tile_shift_;
   const auto k = static_cast<std::size_t>(params_.num_classes);
   if (params_.method == Method::kCsm) {
@@ -448,9 +475,9 @@ void TileInserter::scatter_in_place(const TilePlan& plan, Block& block,
   const Piece piece = piece_of(plan, i, base);
   const CellBox& box = piece.box;
   if (training.labels[i] >= 0) {
-    smooth_point<false>(block, side, box, piece.d2, training, i, kernel);
+    smooth_point<false>(block, side, box, piece.d2, training, i, polynomial_);
   } else {
-    smooth_point<true>(block, side, box, piece.d2, training, i, kernel);
+    smooth_point<true>(block, side, box, piece.d2, training, i, polynomial_);
   }
 }
 
@@ -466,8 +493,8 @@ void TileInserter::write_back(const TilePlan& plan, PlaneTile& scratch, std::siz
   scratch.clear_marks();
 }
 
-void TileInserter::process_tile(const TilePlan& plan, std::size_t tile, const TrainingSet& training,
-                                const KernelTable& kernel) {
+void TileInserter::process_tile(const TilePlan& plan, std::size_t tile,
+                                const TrainingSet& training) {
   const std::array<std::int32_t, 3> base{plan.tiles[tile].x << tile_shift_,
                                          plan.tiles[tile].y << tile_shift_,
                                          plan.tiles[tile].z << tile_shift_};
@@ -475,7 +502,7 @@ void TileInserter::process_tile(const TilePlan& plan, std::size_t tile, const Tr
     // The tile is one block: write into it directly, in the same order as the scratch would.
     Block& block = *plan.tile_blocks[plan.block_offsets[tile]].block;
     for (std::uint32_t p = plan.tile_offsets[tile]; p < plan.tile_offsets[tile + 1]; ++p) {
-      scatter_in_place(plan, block, base, plan.tile_points[p], training, kernel);
+      scatter_in_place(plan, block, base, plan.tile_points[p], training);
     }
     return;
   }
@@ -526,14 +553,13 @@ void TileInserter::plan(const TrainingSet& training, TilePlan& plan) const {
   plan.phases.group = clock.lap();
 }
 
-TileInsertResult TileInserter::insert(const TrainingSet& training, const KernelTable& kernel,
-                                      const BlockAt& block_at) {
+TileInsertResult TileInserter::insert(const TrainingSet& training, const BlockAt& block_at) {
   plan(training, plan_);
-  return apply(plan_, training, kernel, block_at);
+  return apply(plan_, training, block_at);
 }
 
 TileInsertResult TileInserter::apply(TilePlan& plan, const TrainingSet& training,
-                                     const KernelTable& kernel, const BlockAt& block_at) {
+                                     const BlockAt& block_at) {
   TileInsertResult result;
   result.rejected_points = plan.rejected_points;
   result.phases = plan.phases;
@@ -548,7 +574,7 @@ TileInsertResult TileInserter::apply(TilePlan& plan, const TrainingSet& training
       tbb::blocked_range<std::size_t>(0, plan.tiles.size(), in_place ? kBlocksPerTask : 1),
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t t = range.begin(); t != range.end(); ++t) {
-          process_tile(plan, plan.order[t], training, kernel);
+          process_tile(plan, plan.order[t], training);
         }
       },
       tbb::simple_partitioner());

@@ -14,6 +14,7 @@
 #include "fast_floor.hpp"
 #include "plane_tile.hpp"
 #include "semap/common/map_grid.hpp"
+#include "semap/mapping/bki_update.hpp"
 #include "semap/mapping/block.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
@@ -87,21 +88,17 @@ struct TilePlan {
 // order). A one-block tile is written in place. Neither depends on the thread count.
 class TileInserter {
  public:
-  using BlockAt = std::function<Block&(const common::BlockIndex&)>;
-
   explicit TileInserter(const MapParams& params);
 
   // Fuses `training`: plan() then apply(). Points with a bad label or unmappable coordinates
   // are rejected and counted. `block_at` returns the block at an index, creating it; it is
   // called serially before the parallel part.
-  TileInsertResult insert(const TrainingSet& training, const KernelTable& kernel,
-                          const BlockAt& block_at);
+  TileInsertResult insert(const TrainingSet& training, const BlockAt& block_at);
   // The map-independent part of insert: may run for a later scan (any number at once, each
   // with its own plan) while apply() fuses an earlier one.
   void plan(const TrainingSet& training, TilePlan& plan) const;
   // Creates the plan's missing blocks and adds the training set's weights to the map.
-  TileInsertResult apply(TilePlan& plan, const TrainingSet& training, const KernelTable& kernel,
-                         const BlockAt& block_at);
+  TileInsertResult apply(TilePlan& plan, const TrainingSet& training, const BlockAt& block_at);
 
  private:
   void prepare_points(const TrainingSet& training, TilePlan& plan) const;
@@ -111,17 +108,15 @@ class TileInserter {
   bool number_few_tiles(std::size_t pairs, TilePlan& plan) const;
   void mark_blocks(std::size_t tile, TilePlan& plan) const;
   void create_blocks(TilePlan& plan, const BlockAt& block_at, TileInsertResult& result) const;
-  void process_tile(const TilePlan& plan, std::size_t tile, const TrainingSet& training,
-                    const KernelTable& kernel);
+  void process_tile(const TilePlan& plan, std::size_t tile, const TrainingSet& training);
   Piece piece_of(const TilePlan& plan, std::size_t i,
                  const std::array<std::int32_t, 3>& base) const;
   void scatter_in_place(const TilePlan& plan, Block& block, const std::array<std::int32_t, 3>& base,
-                        std::size_t i, const TrainingSet& training,
-                        const KernelTable& kernel) const;
+                        std::size_t i, const TrainingSet& training) const;
   void write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile) const;
 
   MapParams params_;
-  KernelPolynomial polynomial_;  // the kernel of scratch tiles (blocks written in place: table)
+  KernelPolynomial polynomial_;  // the one kernel approximation, of every block size
   std::int32_t block_shift_;     // log2(cells per block side)
   std::int32_t tile_shift_;      // log2(cells per tile side)
   std::int32_t blocks_per_tile_side_;

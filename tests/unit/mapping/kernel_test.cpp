@@ -23,17 +23,6 @@ TEST(SparseKernel, MatchesTheClosedFormAndVanishesAtEll) {
   for (double x = 0.0; x < 0.3; x += 0.01) EXPECT_GE(k(x), k(x + 0.01));
 }
 
-TEST(KernelTable, AgreesWithTheExactKernel) {
-  const SparseKernel exact(10.0f, 0.3f);
-  const KernelTable table(exact);
-  for (int i = 0; i <= 10000; ++i) {
-    const double d = 0.35 * i / 10000.0;
-    EXPECT_NEAR(table(static_cast<float>(d * d)), exact(d), 1e-5 * 10.0) << "d = " << d;
-  }
-  EXPECT_EQ(table(0.09f), 0.0f);
-  EXPECT_EQ(table(1e9f), 0.0f);
-}
-
 TEST(KernelPolynomial, AgreesWithTheExactKernelAndVanishesAtEll) {
   for (const float ell : {0.3f, 0.5f, 1.7f}) {
     const SparseKernel exact(10.0f, ell);

@@ -39,6 +39,12 @@ class Block {
   // Marks the cells of `mask` in the 64-cell word `word` (cells 64 word .. 64 word + 63).
   void mark_observed_word(int word, std::uint64_t mask) { observed_[word] |= mask; }
   int num_observed() const;
+  // The observed bits, cell c at bit c % 64 of word c / 64.
+  std::span<const std::uint64_t> observed_words() const;
+
+  // Adds evidence (num_cells * K floats) and sets the observed bits of `observed` (as
+  // observed_words()): how a block written out by a checkpoint or a pager comes back exactly.
+  void restore(std::span<const float> evidence, std::span<const std::uint64_t> observed);
 
   // Adds evidence for every cell (num_cells * K floats); cells whose added evidence sums to
   // more than zero become observed. This is how maps are merged.

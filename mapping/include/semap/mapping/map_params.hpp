@@ -14,6 +14,14 @@ enum class Method { kBki, kCsm };
 Method method_from_string(const std::string& name);  // "bki" | "csm"
 std::string to_string(Method method);
 
+// How insert computes the update: kTiled, the parallel, vectorised engine (the default), or
+// kPlain, the paper's update one point and cell at a time (bki_update.hpp), which defines what
+// the tiled engine must compute.
+enum class Engine { kTiled, kPlain };
+
+Engine engine_from_string(const std::string& name);  // "tiled" | "plain"
+std::string to_string(Engine engine);
+
 // Parameters of a semantic map, named as in the paper's reference configuration.
 struct MapParams {
   Method method = Method::kBki;
@@ -28,6 +36,7 @@ struct MapParams {
   float max_range = 8.0f;   // hits farther from the origin are dropped; <= 0 keeps all
   // When > 0, a cell whose argmax-class variance exceeds this is reported unknown.
   float unknown_variance = 0.0f;
+  Engine engine = Engine::kTiled;
 
   int cells_per_side() const { return 1 << (block_depth - 1); }
   int cells_per_block() const { return cells_per_side() * cells_per_side() * cells_per_side(); }
@@ -39,7 +48,7 @@ struct MapParams {
 };
 
 // Reads a `map:`-shaped section (method, resolution, block_depth, num_classes, sf2, ell,
-// prior, free_res, ds_res, max_range, unknown_variance); absent keys keep `defaults`.
+// prior, free_res, ds_res, max_range, unknown_variance, engine); absent keys keep `defaults`.
 // Does not call finish(), so callers may read further keys from the same section.
 MapParams map_params_from_config(const common::ConfigSection& section,
                                  const MapParams& defaults = MapParams{});

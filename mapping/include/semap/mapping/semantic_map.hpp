@@ -26,7 +26,8 @@ struct TilePlan;
 }  // namespace detail
 
 struct MapStats {
-  std::size_t blocks = 0;
+  std::size_t blocks = 0;          // blocks in memory
+  std::size_t evicted_blocks = 0;  // blocks a pager moved out of memory (evict)
   std::size_t cells = 0;           // allocated cells (blocks * cells per block)
   std::size_t observed_cells = 0;  // cells that received evidence
   std::size_t bytes = 0;           // blocks plus the block table
@@ -82,7 +83,8 @@ class SemanticMap {
   std::vector<InsertResult> insert(std::span<const common::LabeledCloud> clouds,
                                    std::span<const Eigen::Vector3f> origins);
   // Fuses a prepared training set: each point adds k(d) y to every cell centre within ell
-  // (S-BKI) or y to the cell containing it (S-CSM).
+  // (S-BKI) or y to the cell containing it (S-CSM); bki_update.hpp states the update, and
+  // params().engine says which engine computes it.
   InsertResult insert(const TrainingSet& training);
 
   // The cell containing `point`; nullopt outside allocated blocks.
@@ -90,10 +92,13 @@ class SemanticMap {
   // Class at `point`: the argmax, or -1 where the map is unknown.
   int label_at(const Eigen::Vector3f& point) const;
 
-  // Calls f(const common::BlockIndex&, const Block&) for every block, in no particular order.
+  // Calls f(const common::BlockIndex&, const Block&) for every block in memory, in no particular
+  // order.
   template <typename F>
   void for_each_block(F&& f) const {
-    for (std::size_t b = 0; b < blocks_.size(); ++b) f(indices_[b], blocks_[b]);
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      if (resident_[b]) f(indices_[b], blocks_[b]);
+    }
   }
   // Calls f(const Eigen::Vector3f& centre, const common::CellPosterior&) for every observed cell.
   template <typename F>
@@ -107,25 +112,38 @@ class SemanticMap {
     });
   }
 
+  // The block at `index` if it is in memory.
   const Block* find_block(const common::BlockIndex& index) const;
   // Adds evidence (cells per block * K floats) to a block, creating it if needed (merging).
   // Throws std::invalid_argument for a block index beyond +-2^20 or a wrong float count.
   void add_evidence(const common::BlockIndex& index, std::span<const float> evidence);
+  // Adds a block's evidence and observed bits as Block::restore does, creating it if needed:
+  // a block coming back from a checkpoint or a pager. Throws as add_evidence.
+  void restore_block(const common::BlockIndex& index, std::span<const float> evidence,
+                     std::span<const std::uint64_t> observed);
+  // Drops the block at `index` from memory (a pager has written it out); its storage is reused
+  // by the next block created. Returns false when it is not in memory. An insert that reaches
+  // an evicted block starts it again from zero evidence: restore it first.
+  bool evict(const common::BlockIndex& index);
 
   common::BlockIndex block_of(const Eigen::Vector3f& point) const;
   Eigen::Vector3f cell_center(const common::BlockIndex& block, int cell) const;
 
   MapStats stats() const;
+  // Inserts so far (cheap, unlike stats()).
+  std::size_t scans() const { return scans_; }
 
  private:
   Block& block_at(const common::BlockIndex& index);
+  // Zeroed evidence storage for one block: an evicted block's, or fresh from the arena.
+  float* new_storage();
+  void check_block_evidence(const common::BlockIndex& index, std::span<const float> evidence) const;
   // insert(training), with the map-independent part already done when `plan` is given.
   InsertResult fuse(const TrainingSet& training, detail::TilePlan* plan);
   // fuse() plus the training set's own rejected and out-of-range counts (scans given as clouds).
   InsertResult fuse_scan(const TrainingSet& training, detail::TilePlan* plan);
 
   MapParams params_;
-  KernelTable kernel_;
   // The block table: an open-addressing map from block index to the block's position in
   // blocks_ (a deque, so Block references stay valid while blocks are added).
   VoxelHashMap table_;
@@ -133,6 +151,9 @@ class SemanticMap {
   // Before blocks_: the blocks' evidence lives in it, so it must be destroyed after them.
   BlockArena arena_;
   std::deque<Block> blocks_;
+  std::vector<std::uint8_t> resident_;  // per entry of blocks_: 0 once evicted
+  std::vector<float*> spare_storage_;   // evidence storage of evicted blocks, for reuse
+  std::size_t evicted_ = 0;
   std::size_t scans_ = 0;
   std::size_t rejected_ = 0;
   // Insertion engine with its per-scan buffers and per-thread scratch, reused across scans.

@@ -1,0 +1,153 @@
+#include "semap/mapping/map_checkpoint.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace semap::mapping {
+
+MapCheckpoint::MapCheckpoint(SemanticMap& map, const CheckpointParams& params, bool load)
+    : map_(map),
+      params_(params),
+      log_(params.path, map.params(), params.durable),
+      last_(std::chrono::steady_clock::now()) {
+  if (params_.resume) {
+    stats_.resumed_scans = log_.committed_scans();
+    if (load) stats_.resumed_blocks = log_.load_all(map_);
+  }
+  stats_.log_bytes = log_.bytes();
+  writer_ = std::jthread([this](std::stop_token stop) { run(stop); });
+}
+
+MapCheckpoint::~MapCheckpoint() {
+  writer_.request_stop();
+  wake_.notify_all();
+}
+
+void MapCheckpoint::after_insert(const InsertResult& result) {
+  dirty_.insert(result.updated_blocks.begin(), result.updated_blocks.end());
+  poll();
+}
+
+void MapCheckpoint::poll() {
+  if (dirty_.empty()) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - last_).count() < params_.interval_s) return;
+  std::lock_guard lock(mutex_);
+  if (pending_) return;  // the writer is still busy: these changes go in the next one
+  batch_ = copy_dirty();
+  pending_ = true;
+  last_ = now;
+  wake_.notify_all();
+}
+
+MapCheckpoint::Batch MapCheckpoint::copy_dirty() {
+  Batch batch;
+  batch.scans = map_.scans();
+  batch.blocks.reserve(dirty_.size());
+  for (const common::BlockIndex& index : dirty_) {
+    // A block a pager moved out is already in the log, newer than any copy here.
+    const Block* block = map_.find_block(index);
+    if (block == nullptr) continue;
+    const auto evidence = block->evidence();
+    const auto observed = block->observed_words();
+    batch.blocks.push_back(
+        {index, {evidence.begin(), evidence.end()}, {observed.begin(), observed.end()}});
+  }
+  dirty_.clear();
+  return batch;
+}
+
+void MapCheckpoint::write(const Batch& batch) {
+  const auto start = std::chrono::steady_clock::now();
+  for (const BlockCopy& copy : batch.blocks) {
+    log_.append(copy.index, batch.scans, copy.evidence, copy.observed);
+  }
+  log_.commit(batch.scans);
+  log_.compact();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard lock(mutex_);
+  ++stats_.checkpoints;
+  stats_.blocks_written += batch.blocks.size();
+  stats_.last_write_s = seconds;
+  stats_.max_write_s = std::max(stats_.max_write_s, seconds);
+  stats_.log_bytes = log_.bytes();
+}
+
+void MapCheckpoint::run(std::stop_token stop) {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, stop, [this] { return pending_; });
+    if (!pending_) return;  // stop requested
+    lock.unlock();
+    write(batch_);
+    lock.lock();
+    pending_ = false;
+    batch_ = {};
+    done_.notify_all();
+  }
+}
+
+void MapCheckpoint::flush() {
+  {
+    std::unique_lock lock(mutex_);
+    done_.wait(lock, [this] { return !pending_; });
+  }
+  write(copy_dirty());
+  last_ = std::chrono::steady_clock::now();
+}
+
+MapCheckpoint::Stats MapCheckpoint::stats() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+MapPager::MapPager(SemanticMap& map, BlockLog& log, double radius_m)
+    : map_(map), log_(log), radius_(radius_m) {
+  for (const common::BlockIndex& index : log_.blocks()) {
+    if (map_.find_block(index) == nullptr) out_.insert(index);
+  }
+}
+
+void MapPager::after_insert(const InsertResult& result) {
+  for (const common::BlockIndex& index : result.updated_blocks) {
+    // The insert started this block again from zero: add its evidence from the log.
+    if (out_.erase(index) == 1) {
+      log_.load(index, map_);
+      ++stats_.restored;
+      ++stats_.late_restores;
+    }
+  }
+}
+
+void MapPager::update(const Eigen::Vector3f& robot) {
+  const common::MapGrid grid = map_.params().grid();
+  const float side = map_.params().block_size();
+  const auto distance = [&](const common::BlockIndex& index) {
+    const Eigen::Vector3f centre = grid.block_origin(index) + Eigen::Vector3f::Constant(side / 2);
+    return static_cast<double>((centre - robot).norm());
+  };
+  std::vector<common::BlockIndex> far;
+  map_.for_each_block([&](const common::BlockIndex& index, const Block&) {
+    if (distance(index) > radius_ + side) far.push_back(index);
+  });
+  const auto scans = static_cast<std::uint64_t>(map_.scans());
+  for (const common::BlockIndex& index : far) {
+    const Block& block = *map_.find_block(index);
+    log_.append(index, scans, block.evidence(), block.observed_words());
+    map_.evict(index);
+    out_.insert(index);
+    ++stats_.evicted;
+  }
+  std::vector<common::BlockIndex> near;
+  for (const common::BlockIndex& index : out_) {
+    if (distance(index) <= radius_) near.push_back(index);
+  }
+  for (const common::BlockIndex& index : near) {
+    log_.load(index, map_);
+    out_.erase(index);
+    ++stats_.restored;
+  }
+}
+
+}  // namespace semap::mapping

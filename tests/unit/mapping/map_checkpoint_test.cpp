@@ -1,0 +1,167 @@
+#include "semap/mapping/map_checkpoint.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <thread>
+
+#include "toy_dataset.hpp"
+
+namespace semap::mapping {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Not named by the process: a death test's child process (re-executed) must find the same one.
+fs::path scratch_dir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("semap_checkpoint_" + std::to_string(::getuid()) + "_" + name);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Bit-for-bit equality of the blocks in memory.
+void expect_same_map(const SemanticMap& a, const SemanticMap& b) {
+  EXPECT_EQ(a.stats().blocks, b.stats().blocks);
+  std::size_t differing = 0;
+  a.for_each_block([&](const common::BlockIndex& index, const Block& block) {
+    const Block* other = b.find_block(index);
+    if (other == nullptr ||
+        !std::equal(block.evidence().begin(), block.evidence().end(), other->evidence().begin()) ||
+        !std::equal(block.observed_words().begin(), block.observed_words().end(),
+                    other->observed_words().begin())) {
+      ++differing;
+    }
+  });
+  EXPECT_EQ(differing, 0u);
+}
+
+// The robot: inserts the toy scans, checkpointing after every insert, and is killed with
+// SIGKILL after `scans` of them (optionally after idling for 0.5 s, polling as the mapping
+// stage does while no scans arrive).
+[[noreturn]] void map_then_get_killed(const fs::path& log, int scans, bool let_writer_finish) {
+  SemanticMap map{MapParams{}};
+  MapCheckpoint checkpoint(map, {.path = log, .interval_s = 0.0});
+  const auto clouds = testing::toy_scans(1, scans);
+  for (const auto& cloud : clouds) checkpoint.after_insert(map.insert(cloud, cloud.origin));
+  for (int idle = 0; let_writer_finish && idle < 50; ++idle) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    checkpoint.poll();
+  }
+  std::raise(SIGKILL);
+  std::abort();
+}
+
+class KilledRobot : public ::testing::TestWithParam<bool> {};
+
+// kill -9 while mapping: the log holds the map of some number of scans exactly (a commit
+// point), losing at most what the writer had not committed; given time, nothing.
+TEST_P(KilledRobot, ResumesTheMapOfItsLastCheckpointExactly) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const bool let_writer_finish = GetParam();
+  const fs::path dir = scratch_dir(let_writer_finish ? "settled" : "racing");
+  fs::remove(dir / "map.log");  // the child re-runs this line before it starts mapping
+  constexpr int kScans = 9;
+  EXPECT_EXIT(map_then_get_killed(dir / "map.log", kScans, let_writer_finish),
+              ::testing::KilledBySignal(SIGKILL), "");
+
+  SemanticMap resumed{MapParams{}};
+  MapCheckpoint checkpoint(resumed, {.path = dir / "map.log", .resume = true});
+  const auto stats = checkpoint.stats();
+  if (let_writer_finish) {
+    EXPECT_EQ(stats.resumed_scans, static_cast<std::uint64_t>(kScans));
+  } else {
+    EXPECT_GE(stats.resumed_scans, 1u);
+    EXPECT_LE(stats.resumed_scans, static_cast<std::uint64_t>(kScans));
+  }
+  EXPECT_EQ(stats.resumed_blocks, resumed.stats().blocks);
+
+  // The uninterrupted run, stopped at the same scan.
+  SemanticMap reference{MapParams{}};
+  for (const auto& cloud : testing::toy_scans(1, static_cast<int>(stats.resumed_scans))) {
+    reference.insert(cloud, cloud.origin);
+  }
+  expect_same_map(reference, resumed);
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Timing, KilledRobot, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "WriterFinished" : "WriterRacing";
+                         });
+
+// A scan of a straight street seen from `x`: ground and two walls within 7 m.
+common::LabeledCloud street_scan(float x) {
+  common::LabeledCloud cloud;
+  cloud.origin = {x, 0.0f, 1.0f};
+  for (float dx = -7.0f; dx <= 7.0f; dx += 0.25f) {
+    for (float y = -3.9f; y <= 3.9f; y += 0.25f) {
+      cloud.points.emplace_back(x + dx, y, 0.0f);
+      cloud.labels.push_back(1);
+    }
+    for (float z = 0.2f; z <= 3.0f; z += 0.25f) {
+      for (const float y : {-4.0f, 4.0f}) {
+        cloud.points.emplace_back(x + dx, y, z);
+        cloud.labels.push_back(y < 0 ? 2 : 3);
+      }
+    }
+  }
+  return cloud;
+}
+
+// A long drive out and back with a memory radius: the resident blocks stay bounded far below
+// the map's size, and the map written out at the end equals the map of the same drive kept
+// entirely in memory.
+TEST(MapPager, LongDriveStaysBoundedAndLosesNothing) {
+  const fs::path dir = scratch_dir("drive");
+  fs::remove(dir / "map.log");
+  MapParams params;
+  params.resolution = 0.2f;
+  params.max_range = 8.0f;
+  params.free_res = 1.0f;
+  params.ds_res = 0.2f;
+  std::vector<float> stops;
+  for (float x = 0.0f; x <= 320.0f; x += 2.5f) stops.push_back(x);
+  for (float x = 317.5f; x >= 0.0f; x -= 2.5f) stops.push_back(x);
+
+  SemanticMap reference(params);
+  for (const float x : stops) {
+    const auto cloud = street_scan(x);
+    reference.insert(cloud, cloud.origin);
+  }
+
+  SemanticMap map(params);
+  std::size_t max_resident = 0;
+  MapPager::Stats pager_stats;
+  {
+    MapCheckpoint checkpoint(map, {.path = dir / "map.log", .interval_s = 0.0, .durable = false});
+    // max_range + ell + a block diagonal (1.4 m) < 12 m: every block a scan reaches is in memory.
+    MapPager pager(map, checkpoint.log(), 12.0);
+    for (const float x : stops) {
+      const auto cloud = street_scan(x);
+      pager.update(cloud.origin);
+      const InsertResult result = map.insert(cloud, cloud.origin);
+      pager.after_insert(result);
+      checkpoint.after_insert(result);
+      max_resident = std::max(max_resident, map.stats().blocks);
+    }
+    checkpoint.flush();
+    pager_stats = pager.stats();
+  }
+  const std::size_t total = reference.stats().blocks;
+  EXPECT_GE(total, 10 * max_resident) << "total " << total << ", max resident " << max_resident;
+  EXPECT_GT(pager_stats.evicted, total);  // blocks left behind on the way out and back
+  EXPECT_GT(pager_stats.restored, total / 2);
+  EXPECT_EQ(pager_stats.late_restores, 0u);
+
+  SemanticMap reloaded(params);
+  BlockLog(dir / "map.log", params).load_all(reloaded);
+  expect_same_map(reference, reloaded);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace semap::mapping
