@@ -5,20 +5,6 @@
 
 namespace semap::onboard {
 
-dds_idl::MapDescription describe_map(const OnboardConfig& config) {
-  dds_idl::MapDescription d;
-  d.resolution = config.map.resolution;
-  d.block_cells = static_cast<std::uint16_t>(config.map.cells_per_side());
-  d.num_classes = static_cast<std::uint16_t>(config.map.num_classes);
-  const std::vector<std::string> names{"free", "ground", "building", "pole"};
-  const std::vector<std::uint32_t> colors{0xffffff, 0x808080, 0xc04040, 0x40a040};
-  if (config.map.num_classes == static_cast<int>(names.size())) {
-    d.class_names = names;
-    d.class_colors = colors;
-  }
-  return d;
-}
-
 DdsOutputs::DdsOutputs(const OnboardConfig& config)
     : config_(config),
       participant_(static_cast<dds_domainid_t>(config.dds.domain)),

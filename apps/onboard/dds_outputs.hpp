@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "estimation_stage.hpp"
+#include "mapping_stage.hpp"
 #include "onboard_config.hpp"
 #include "semap/dds_idl/health.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
@@ -46,8 +47,5 @@ class DdsOutputs {
   std::size_t map_pending_ = 0;
   std::uint64_t health_written_ = 0;  // main thread only
 };
-
-// Class names and colours of the built-in world, for MapInfo.
-dds_idl::MapDescription describe_map(const OnboardConfig& config);
 
 }  // namespace semap::onboard

@@ -6,12 +6,15 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 #include "dds_outputs.hpp"
 #include "estimation_stage.hpp"
@@ -202,17 +205,40 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   std::unique_ptr<onboard::DdsOutputs> dds;
   if (config.dds.enabled) dds = std::make_unique<onboard::DdsOutputs>(config);
 
-  onboard::EstimationStage estimation_stage(
-      config, imu_ring, gnss_ring, poses,
-      dds ? onboard::EstimationStage::PoseSink(
-                [&](const onboard::PoseOutput& p) { dds->publish_pose(p); })
-          : nullptr);
+  std::filesystem::path checkpoint_path = config.map_checkpoint_path;
+  if (checkpoint_path.empty() && !config.map_save_path.empty()) {
+    checkpoint_path = config.map_save_path + ".log";
+  }
+  if (checkpoint_path.empty() && report) checkpoint_path = report->dir() / "map.log";
   onboard::MappingStage mapping_stage(
       config, cloud_ring,
       dds ? onboard::MappingStage::BlockSink(
                 [&](std::vector<dds_idl::BlockSnapshot>&& b, common::Stamp now) {
                   dds->publish_blocks(std::move(b), now);
                 })
+          : nullptr,
+      checkpoint_path);
+  // A resumed map lives in the frame it was built in: the estimator anchors there too.
+  onboard::OnboardConfig estimation_config = config;
+  if (const auto frame = mapping_stage.map_frame()) {
+    const estimation::Geodetic anchor{(*frame)[0], (*frame)[1], (*frame)[2]};
+    const auto& given = config.estimator.anchor;
+    if (given && (std::abs(given->latitude_deg - anchor.latitude_deg) > 1e-7 ||
+                  std::abs(given->longitude_deg - anchor.longitude_deg) > 1e-7 ||
+                  std::abs(given->altitude_m - anchor.altitude_m) > 0.01)) {
+      throw std::runtime_error("map.resume: the checkpoint's map is anchored at " +
+                               std::to_string(anchor.latitude_deg) + ", " +
+                               std::to_string(anchor.longitude_deg) + ", " +
+                               std::to_string(anchor.altitude_m) + " but estimator.anchor differs");
+    }
+    estimation_config.estimator.anchor = anchor;
+    log->info("map frame anchored at {:.8f}, {:.8f}, {:.2f} (from the checkpoint)",
+              anchor.latitude_deg, anchor.longitude_deg, anchor.altitude_m);
+  }
+  onboard::EstimationStage estimation_stage(
+      estimation_config, imu_ring, gnss_ring, poses,
+      dds ? onboard::EstimationStage::PoseSink(
+                [&](const onboard::PoseOutput& p) { dds->publish_pose(p); })
           : nullptr);
 
   if (gnss_driver) gnss_driver->start();
@@ -238,9 +264,15 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   onboard::HealthMonitor health;
   Progress progress;
   auto next_health = started;
+  bool frame_recorded = false;
   while (!g_stop.load()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const auto est = estimation_stage.stats();
+    if (est.anchor && !frame_recorded) {
+      mapping_stage.record_map_frame(
+          {est.anchor->latitude_deg, est.anchor->longitude_deg, est.anchor->altitude_m});
+      frame_recorded = true;
+    }
     if (rig) accuracy.sample(*rig, est);
     if (report) report->sample_pose(est);
     const auto now = common::Stamp::now();
@@ -345,6 +377,18 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
       map.scans ? 1e3 * map.insert_seconds_total / static_cast<double>(map.scans) : 0.0,
       1e3 * map.insert_seconds_max, map.map.blocks, map.map.observed_cells,
       map.map.bytes_per_cell());
+  if (map.checkpoint.checkpoints > 0 || map.checkpoint.resumed_scans > 0) {
+    std::printf(
+        "map checkpoint   : %s, %lu checkpoints, %lu blocks written, write max %.1f ms, "
+        "%.1f MB, resumed %lu blocks of %lu scans\n",
+        checkpoint_path.c_str(), map.checkpoint.checkpoints, map.checkpoint.blocks_written,
+        1e3 * map.checkpoint.max_write_s, static_cast<double>(map.checkpoint.log_bytes) / 1e6,
+        map.checkpoint.resumed_blocks, map.checkpoint.resumed_scans);
+  }
+  if (config.map_memory_radius_m > 0.0) {
+    std::printf("map paging       : radius %.0f m, %lu blocks paged out, %lu paged in\n",
+                config.map_memory_radius_m, map.pager.evicted, map.pager.restored);
+  }
   if (dds) {
     const auto m = dds->map_counters();
     std::printf(
@@ -399,6 +443,9 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration, "seconds to run; overrides rig.duration_s (0: Ctrl-C)");
   app.add_option("--domain", domain, "DDS domain id; overrides dds.domain")
       ->check(CLI::Range(0, 232));
+  bool resume = false;
+  app.add_flag("--resume", resume,
+               "continue the map in the checkpoint log (map.resume) instead of starting anew");
   app.add_option("--report", report_dir,
                  "simulated rig only: write camera.png, trajectory.png, map.smap and "
                  "summary.json into this directory");
@@ -417,6 +464,7 @@ int main(int argc, char** argv) {
   }
   if (duration) config.rig.duration_s = *duration;
   if (domain) config.dds.domain = *domain;
+  if (resume) config.map_resume = true;
   semap::common::setup_logging(config.log_level);
   if (config.dds.enabled && !config.dds.cyclone_config.empty() && !std::getenv("CYCLONEDDS_URI")) {
     setenv("CYCLONEDDS_URI", ("file://" + config.dds.cyclone_config.string()).c_str(), 1);

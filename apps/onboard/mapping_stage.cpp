@@ -3,8 +3,23 @@
 #include <tbb/task_arena.h>
 
 #include <chrono>
+#include <filesystem>
+
+#include "semap/common/logging.hpp"
 
 namespace semap::onboard {
+
+dds_idl::MapDescription describe_map(const OnboardConfig& config) {
+  dds_idl::MapDescription d;
+  d.resolution = config.map.resolution;
+  d.block_cells = static_cast<std::uint16_t>(config.map.cells_per_side());
+  d.num_classes = static_cast<std::uint16_t>(config.map.num_classes);
+  d.class_names = config.map_palette.names;
+  for (const mapping::Rgb& rgb : config.map_palette.colors) {
+    d.class_colors.push_back(std::uint32_t{rgb[0]} << 16 | std::uint32_t{rgb[1]} << 8 | rgb[2]);
+  }
+  return d;
+}
 
 dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
                                    const mapping::Block& block, std::uint32_t version) {
@@ -18,8 +33,46 @@ dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common
 }
 
 MappingStage::MappingStage(const OnboardConfig& config,
-                           common::SpscRing<common::LabeledCloud>& clouds, BlockSink sink)
-    : config_(config), clouds_(clouds), sink_(std::move(sink)), map_(config.map) {}
+                           common::SpscRing<common::LabeledCloud>& clouds, BlockSink sink,
+                           const std::filesystem::path& checkpoint_path)
+    : config_(config), clouds_(clouds), sink_(std::move(sink)), map_(config.map) {
+  if (checkpoint_path.empty() || config.map_checkpoint_s <= 0.0) return;
+  if (checkpoint_path.has_parent_path()) {
+    std::filesystem::create_directories(checkpoint_path.parent_path());
+  }
+  if (!config.map_resume && std::filesystem::exists(checkpoint_path)) {
+    // A new map: the previous run's checkpoint is kept beside it, not continued or deleted.
+    std::filesystem::path previous = checkpoint_path;
+    previous += ".previous";
+    std::filesystem::rename(checkpoint_path, previous);
+    common::logger("mapping")->info("previous map checkpoint moved to {}", previous.string());
+  }
+  const bool paged = config.map_memory_radius_m > 0.0;
+  checkpoint_ = std::make_unique<mapping::MapCheckpoint>(
+      map_,
+      mapping::CheckpointParams{.path = checkpoint_path,
+                                .interval_s = config.map_checkpoint_s,
+                                .resume = config.map_resume},
+      !paged);
+  const auto log = common::logger("mapping");
+  if (!checkpoint_->damage().empty()) {
+    log->warn("map checkpoint: {}; resuming from the last complete checkpoint",
+              checkpoint_->damage());
+  }
+  if (config.map_resume) {
+    const auto stats = checkpoint_->stats();
+    log->info("map resumed from {}: {} blocks of {} scans{}", checkpoint_path.string(),
+              paged ? checkpoint_->log().blocks().size() : stats.resumed_blocks,
+              stats.resumed_scans, paged ? " (paged in as the robot gets near)" : "");
+  }
+  if (paged) {
+    pager_ =
+        std::make_unique<mapping::MapPager>(map_, checkpoint_->log(), config.map_memory_radius_m);
+  }
+  local_.checkpoint = checkpoint_->stats();
+  local_.map = map_.stats();
+  shared_ = local_;
+}
 
 MappingStage::~MappingStage() { stop(); }
 
@@ -31,7 +84,26 @@ void MappingStage::stop() {
   if (thread_.joinable()) {
     thread_.request_stop();
     thread_.join();
+    if (checkpoint_) {
+      checkpoint_->flush();
+      local_.checkpoint = checkpoint_->stats();
+      std::lock_guard lock(stats_mutex_);
+      shared_ = local_;
+    }
   }
+}
+
+void MappingStage::record_map_frame(const mapping::MapFrame& frame) {
+  if (checkpoint_ && !checkpoint_->frame()) checkpoint_->set_frame(frame);
+}
+
+const mapping::SemanticMap& MappingStage::map() {
+  if (!pager_) return map_;
+  if (!full_map_) {
+    full_map_ = std::make_unique<mapping::SemanticMap>(config_.map);
+    checkpoint_->log().load_all(*full_map_);
+  }
+  return *full_map_;
 }
 
 MappingStageStats MappingStage::stats() const {
@@ -41,10 +113,18 @@ MappingStageStats MappingStage::stats() const {
 
 void MappingStage::run(std::stop_token stop) {
   tbb::task_arena arena(config_.map_threads);
+  if (config_.map_resume && sink_) {
+    // Subscribers get the resumed map before anything new.
+    std::vector<common::BlockIndex> resumed;
+    map_.for_each_block(
+        [&](const common::BlockIndex& index, const mapping::Block&) { resumed.push_back(index); });
+    sink_(snapshots_of(resumed), common::Stamp::now());
+  }
   common::LabeledCloud cloud;
   while (!stop.stop_requested()) {
     if (!clouds_.try_pop(cloud)) {
       if (sink_) sink_({}, common::Stamp::now());  // lets the publisher keep its rates
+      if (checkpoint_) checkpoint_->poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       continue;
     }
@@ -54,7 +134,10 @@ void MappingStage::run(std::stop_token stop) {
 
 void MappingStage::insert(const common::LabeledCloud& cloud) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (pager_) pager_->update(cloud.origin);
   const auto result = map_.insert(cloud, cloud.origin);
+  if (pager_) pager_->after_insert(result);
+  if (checkpoint_) checkpoint_->after_insert(result);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
@@ -65,6 +148,8 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   local_.insert_seconds_total += seconds;
   local_.insert_seconds_max = std::max(local_.insert_seconds_max, seconds);
   local_.map = map_.stats();
+  if (checkpoint_) local_.checkpoint = checkpoint_->stats();
+  if (pager_) local_.pager = pager_->stats();
   if (sink_) sink_(std::move(snapshots), common::Stamp::now());
   std::lock_guard lock(stats_mutex_);
   shared_ = local_;

@@ -12,6 +12,7 @@
 #include "semap/estimation/estimator_config.hpp"
 #include "semap/estimation/simulator.hpp"
 #include "semap/firmware_bridge/emulator.hpp"
+#include "semap/mapping/class_palette.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/semantic_layers.hpp"
 #include "sim_camera_feed.hpp"
@@ -71,8 +72,18 @@ struct OnboardConfig {
   SegmenterConfig segmenter;
   estimation::EstimatorConfig estimator;
   mapping::MapParams map;
-  std::string map_save_path;       // .smap written at exit when set
-  mapping::SourceId robot_id = 1;  // this robot's evidence layer in saved and merged maps
+  std::string map_save_path;  // .smap written at exit when set
+  // Names and colours of the map's classes (map.palette, a YAML file as semap-export reads),
+  // published in MapInfo for planners and viewers.
+  mapping::ClassPalette map_palette;
+  // The live map's crash-safe checkpoint (mapping::MapCheckpoint): a block log written every
+  // map_checkpoint_s (0: none). An empty path means <save_path>.log, or map.log in the
+  // --report directory, or no checkpoint when neither is given.
+  std::string map_checkpoint_path;
+  double map_checkpoint_s = 10.0;
+  bool map_resume = false;           // continue the map in the checkpoint at start
+  double map_memory_radius_m = 0.0;  // > 0: blocks farther away go to the checkpoint log
+  mapping::SourceId robot_id = 1;    // this robot's evidence layer in saved and merged maps
   int map_threads = 2;
   // Frames are mapped only once the filter's heading is known to within this (1 sigma):
   // a filter that starts from a guessed heading would otherwise smear the map.

@@ -172,7 +172,7 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   onboard::PerceptionStage perception(config.camera, config.depth,
                                       onboard::make_segmenter(seg, config.map.num_classes),
                                       colour_ring, &depth_ring, poses, cloud_ring);
-  onboard::MappingStage mapping(config, cloud_ring, nullptr);
+  onboard::MappingStage mapping(config, cloud_ring, nullptr, {});
 
   // The estimation stage's part: filter poses at 200 Hz, stamped now.
   const common::Stamp t0 = common::Stamp::now();

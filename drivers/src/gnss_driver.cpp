@@ -7,20 +7,7 @@ namespace {
 
 using firmware_bridge::GnssStreamCounters;
 
-GnssStreamCounters sum(const GnssStreamCounters& a, const GnssStreamCounters& b) {
-  GnssStreamCounters s;
-  s.bytes = a.bytes + b.bytes;
-  s.garbage_bytes = a.garbage_bytes + b.garbage_bytes;
-  s.nmea_sentences = a.nmea_sentences + b.nmea_sentences;
-  s.ubx_frames = a.ubx_frames + b.ubx_frames;
-  s.bad_checksum = a.bad_checksum + b.bad_checksum;
-  s.too_long = a.too_long + b.too_long;
-  s.truncated = a.truncated + b.truncated;
-  s.unknown = a.unknown + b.unknown;
-  s.bad_field = a.bad_field + b.bad_field;
-  s.fixes = a.fixes + b.fixes;
-  return s;
-}
+GnssStreamCounters sum(GnssStreamCounters a, const GnssStreamCounters& b) { return a += b; }
 
 // Rejected input other than checksum failures: the driver's `errors` counter.
 std::uint64_t malformed(const GnssStreamCounters& c) {

@@ -200,6 +200,7 @@ SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::ui
     fix.altitude_m = g.altitude_m;
     fix.covariance = Eigen::Matrix3d::Identity() * gnss_sigma_m * gnss_sigma_m;
     fix.quality = common::FixQuality::kGps;
+    fix.mode = common::FixMode::k3D;
     fix.satellites = static_cast<std::uint8_t>(std::clamp(r.satellites, 0, 255));
     out.gnss.push_back(fix);
   }

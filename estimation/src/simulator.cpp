@@ -184,6 +184,7 @@ SimulationData simulate(const SimulatorConfig& c) {
             fix.altitude_m = g.altitude_m;
             fix.covariance = Eigen::Matrix3d::Identity() * c.gnss_sigma_m * c.gnss_sigma_m;
             fix.quality = common::FixQuality::kGps;
+            fix.mode = common::FixMode::k3D;
             fix.satellites = 12;
             if (c.gnss_velocity) {
               fix.velocity_enu = mg.state.velocity + c.gnss_velocity_sigma_m_s * gaussian3();

@@ -58,6 +58,7 @@ common::GnssFix ConstantTurnSource::gnss_at(std::uint64_t index) const {
   const double s = config_.gnss_sigma_m;
   fix.covariance = Eigen::Vector3d(s * s, s * s, 4 * s * s).asDiagonal();
   fix.quality = common::FixQuality::kGps;
+  fix.mode = common::FixMode::k3D;
   fix.satellites = 12;
   fix.velocity_enu = Eigen::Vector3d(v * std::cos(yaw), v * std::sin(yaw), 0.0);
   return fix;

@@ -11,6 +11,7 @@
 
 #include "semap/firmware_bridge/gnss_encoder.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
+#include "semap/firmware_bridge/rtcm3.h"
 
 namespace semap::firmware_bridge {
 
@@ -21,7 +22,7 @@ constexpr double kMetersPerDegreeLat = 111'320.0;
 constexpr int kSerialStallMs = 100;
 // Injected garbage avoids frame starts and printable text, so that each burst is exactly
 // "garbage" to a receiver and never forms or extends a frame.
-constexpr std::uint8_t kNoGarbage[] = {'$', SEMAP_UBX_SYNC1, '\n'};
+constexpr std::uint8_t kNoGarbage[] = {'$', SEMAP_UBX_SYNC1, SEMAP_RTCM3_PREAMBLE, '\n'};
 
 enum class CanFault { kNone, kCrc, kDrop, kGap };
 

@@ -5,6 +5,22 @@
 
 namespace semap::firmware_bridge {
 
+GnssStreamCounters& GnssStreamCounters::operator+=(const GnssStreamCounters& o) {
+  bytes += o.bytes;
+  garbage_bytes += o.garbage_bytes;
+  nmea_sentences += o.nmea_sentences;
+  ubx_frames += o.ubx_frames;
+  rtcm3_frames += o.rtcm3_frames;
+  text_lines += o.text_lines;
+  bad_checksum += o.bad_checksum;
+  too_long += o.too_long;
+  truncated += o.truncated;
+  unknown += o.unknown;
+  bad_field += o.bad_field;
+  fixes += o.fixes;
+  return *this;
+}
+
 GnssStreamDecoder::GnssStreamDecoder(const GnssFixBuilderConfig& config) : builder_(config) {
   semap_gnss_framer_init(&framer_);
 }
@@ -51,7 +67,13 @@ void GnssStreamDecoder::drain(common::Stamp stamp, std::vector<common::GnssFix>&
       count(r.status);
       continue;
     }
-    if (frame.kind == SEMAP_GNSS_FRAME_NMEA) {
+    if (frame.kind == SEMAP_GNSS_FRAME_RTCM3) {
+      ++counters_.rtcm3_frames;
+    } else if (frame.kind == SEMAP_GNSS_FRAME_TEXT) {
+      ++counters_.text_lines;
+    } else if (frame.kind == SEMAP_GNSS_FRAME_UBX_SKIPPED) {
+      ++counters_.unknown;  // no decoded message is that long
+    } else if (frame.kind == SEMAP_GNSS_FRAME_NMEA) {
       SemapNmeaSentence sentence;
       const SemapFbResult p =
           semap_nmea_parse(reinterpret_cast<const char*>(frame.data), frame.len, &sentence);

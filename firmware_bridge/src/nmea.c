@@ -189,8 +189,9 @@ static SemapFbResult parse_vtg(const Field* f, int n, SemapNmeaVtg* v) {
 }
 
 static int parse_talker(const char* s, SemapNmeaTalker* talker) {
-  static const char* const kTalkers[] = {"GP", "GN", "GL", "GA", "GB"};
-  for (int i = 0; i < 5; ++i) {
+  static const char* const kTalkers[SEMAP_NMEA_TALKER_COUNT] = {"GP", "GN", "GL", "GA",
+                                                                "GB", "BD", "GQ", "GI"};
+  for (int i = 0; i < (int)SEMAP_NMEA_TALKER_COUNT; ++i) {
     if (s[0] == kTalkers[i][0] && s[1] == kTalkers[i][1]) {
       *talker = (SemapNmeaTalker)i;
       return 1;
@@ -218,7 +219,7 @@ SemapFbResult semap_nmea_parse(const char* text, size_t len, SemapNmeaSentence* 
     --n;
     terminated = 1;
   }
-  /* Without CR LF the sentence itself may use at most 80 of the 82 characters. */
+  /* Without CR LF the sentence itself may use at most all but two of the characters. */
   if (!terminated && n > SEMAP_NMEA_MAX_LENGTH - 2) return result(SEMAP_FB_TOO_LONG, -1);
   if (n < 4 || text[0] != '$' || text[n - 3] != '*') return result(SEMAP_FB_TRUNCATED, -1);
   const int hi = hex_value(text[n - 2]);

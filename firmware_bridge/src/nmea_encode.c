@@ -57,9 +57,14 @@ static void put_opt_fixed(Writer* w, uint8_t has, double v, int decimals) {
   put_char(w, ',');
 }
 
-static const char* const kTalkers[] = {"GP", "GN", "GL", "GA", "GB"};
+static const char* const kTalkers[SEMAP_NMEA_TALKER_COUNT] = {"GP", "GN", "GL", "GA",
+                                                              "GB", "BD", "GQ", "GI"};
 
 static void begin(Writer* w, SemapNmeaTalker talker, const char* type) {
+  if ((unsigned)talker >= SEMAP_NMEA_TALKER_COUNT) {
+    w->overflow = 1;
+    return;
+  }
   put_char(w, '$');
   put_str(w, kTalkers[talker]);
   put_str(w, type);
@@ -110,7 +115,7 @@ static size_t finish(Writer* w) {
   put_char(w, kHex[sum & 0x0Fu]);
   put_char(w, '\r');
   put_char(w, '\n');
-  if (w->overflow || w->len > SEMAP_NMEA_MAX_LENGTH) return 0;
+  if (w->overflow || w->len > SEMAP_NMEA_STANDARD_LENGTH) return 0;
   if (w->len < w->cap) w->buf[w->len] = '\0';
   return w->len;
 }

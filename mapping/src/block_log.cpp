@@ -19,11 +19,13 @@ constexpr char kMagic[8] = {'S', 'E', 'M', 'A', 'P', 'L', 'O', 'G'};
 constexpr std::uint32_t kVersion = 1;
 constexpr std::uint32_t kBlockRecord = 1;
 constexpr std::uint32_t kCommitRecord = 2;
+constexpr std::uint32_t kFrameRecord = 3;
 // Magic, 4 u32 (version, method, cells per side, K), 4 f32 (resolution, prior, sf2, ell), CRC.
 constexpr std::size_t kHeaderBytes = 8 + 4 * 4 + 4 * 4 + 4;
 // Type and length before a record's payload, CRC after it.
 constexpr std::size_t kFrameBytes = 4 + 4 + 4;
 constexpr std::size_t kCommitPayload = 8;
+constexpr std::size_t kFramePayload = 3 * 8;
 
 std::uint32_t crc_of(std::span<const std::uint8_t> bytes) {
   return static_cast<std::uint32_t>(::crc32(0L, bytes.data(), static_cast<uInt>(bytes.size())));
@@ -85,6 +87,12 @@ std::vector<std::uint8_t> record_bytes(std::uint32_t type,
   return w.bytes;
 }
 
+std::vector<std::uint8_t> frame_record(const MapFrame& frame) {
+  Writer payload;
+  for (const double v : frame) payload.put(v);
+  return record_bytes(kFrameRecord, payload.bytes);
+}
+
 void check_header(std::span<const std::uint8_t> bytes, const MapParams& p,
                   const std::string& name) {
   if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
@@ -123,6 +131,7 @@ BlockLogScan scan_block_log(std::span<const std::uint8_t> bytes, const MapParams
   scan.end = kHeaderBytes;
   // Blocks since the last commit, applied when the next commit arrives.
   std::unordered_map<common::BlockIndex, BlockLogEntry, common::BlockIndexHash> pending;
+  std::optional<MapFrame> pending_frame;
   const std::size_t block_bytes = block_payload(params);
   std::size_t at = kHeaderBytes;
   while (at < bytes.size()) {
@@ -135,6 +144,7 @@ BlockLogScan scan_block_log(std::span<const std::uint8_t> bytes, const MapParams
     const auto length = get<std::uint32_t>(bytes, at + 4);
     const std::size_t expected = type == kBlockRecord    ? block_bytes
                                  : type == kCommitRecord ? kCommitPayload
+                                 : type == kFrameRecord  ? kFramePayload
                                                          : 0;
     if (expected == 0) {
       scan.damage = where + "unknown type " + std::to_string(type);
@@ -161,9 +171,13 @@ BlockLogScan scan_block_log(std::span<const std::uint8_t> bytes, const MapParams
                                      get<std::int32_t>(bytes, at + 16)};
       const auto block_scan = get<std::uint64_t>(bytes, at + 20);
       pending[index] = {at, kFrameBytes + length, block_scan};
+    } else if (type == kFrameRecord) {
+      pending_frame = MapFrame{get<double>(bytes, at + 8), get<double>(bytes, at + 16),
+                               get<double>(bytes, at + 24)};
     } else {
       for (const auto& [index, entry] : pending) scan.blocks[index] = entry;
       pending.clear();
+      if (pending_frame) scan.frame = pending_frame;
       scan.committed_scans = get<std::uint64_t>(bytes, at + 8);
       ++scan.commits;
       scan.end = crc_at + 4;
@@ -192,6 +206,7 @@ BlockLog::BlockLog(std::filesystem::path path, const MapParams& params, bool dur
   BlockLogScan scan = scan_block_log(bytes, params_, path_.string());
   blocks_ = std::move(scan.blocks);
   committed_scans_ = scan.committed_scans;
+  frame_ = scan.frame;
   damage_ = std::move(scan.damage);
   end_ = scan.end;
   // Whatever follows the last commit is an unfinished checkpoint: new records replace it.
@@ -247,6 +262,18 @@ void BlockLog::commit(std::uint64_t scans) {
   write_at_end(record);
   if (durable_ && ::fdatasync(fd_) != 0) fail(path_, "fsync");
   committed_scans_ = scans;
+}
+
+void BlockLog::set_frame(const MapFrame& frame) {
+  const auto record = frame_record(frame);
+  std::lock_guard lock(mutex_);
+  write_at_end(record);
+  frame_ = frame;
+}
+
+std::optional<MapFrame> BlockLog::frame() const {
+  std::lock_guard lock(mutex_);
+  return frame_;
 }
 
 std::vector<std::uint8_t> BlockLog::read(const BlockLogEntry& entry) const {
@@ -306,6 +333,11 @@ bool BlockLog::compact(double factor) {
   const auto header = header_bytes(params_);
   put(header);
   at += header.size();
+  if (frame_) {
+    const auto frame = frame_record(*frame_);
+    put(frame);
+    at += frame.size();
+  }
   for (const auto& [index, entry] : blocks_) {
     put(read(entry));
     moved[index] = {at, entry.bytes, entry.scan};

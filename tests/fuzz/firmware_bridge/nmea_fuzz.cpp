@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       break;
   }
   // Re-encoding may not fit in 82 chars (more decimals than the input had): then n == 0.
-  if (n > SEMAP_NMEA_MAX_LENGTH) std::abort();
+  if (n > SEMAP_NMEA_STANDARD_LENGTH) std::abort();
   if (n > 0) {
     SemapNmeaSentence again;
     const SemapFbResult r2 = semap_nmea_parse(buf, n, &again);

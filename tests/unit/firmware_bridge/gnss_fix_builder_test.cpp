@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -40,6 +41,162 @@ TEST(GnssFixBuilder, GstEllipseBecomesEnuCovariance) {
   SemapNmeaGst zero{};
   zero.has_lat_sd = zero.has_lon_sd = zero.has_alt_sd = 1;
   EXPECT_GT(covariance_from_gst(zero).diagonal().minCoeff(), 0.0);
+}
+
+// "$" + body + "*hh\r\n".
+SemapNmeaSentence nmea(const std::string& body) {
+  char hex[3];
+  std::snprintf(hex, sizeof hex, "%02X", semap_nmea_checksum(body.data(), body.size()));
+  return parse("$" + body + "*" + hex + "\r\n");
+}
+
+std::int64_t utc_ns(int y, unsigned mo, unsigned d, int h, int mi, double s) {
+  return days_from_civil(y, mo, d) * 86'400'000'000'000LL +
+         static_cast<std::int64_t>(((h * 60 + mi) * 60) * 1e9) + std::llround(s * 1e9);
+}
+
+TEST(GnssFixBuilder, DaysFromCivil) {
+  EXPECT_EQ(days_from_civil(1970, 1, 1), 0);
+  EXPECT_EQ(days_from_civil(2000, 3, 1), 11017);
+  EXPECT_EQ(days_from_civil(2024, 2, 29), 19782);
+  EXPECT_EQ(days_from_civil(1969, 12, 31), -1);
+}
+
+TEST(GnssFixBuilder, UtcIsGgaTimeOnTheRmcDateAcrossMidnight) {
+  GnssFixBuilder builder;
+  const std::string gga_tail = ",4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,";
+  // No date known yet: no receiver time.
+  auto fix = builder.add(nmea("GPGGA,235958.50" + gga_tail), common::Stamp(1));
+  ASSERT_TRUE(fix);
+  EXPECT_FALSE(fix->utc_ns);
+  builder.add(nmea("GPRMC,235959.50,A,4807.038,N,01131.000,E,0.0,0.0,311225,,,A"),
+              common::Stamp(2));
+  fix = builder.add(nmea("GPGGA,235959.50" + gga_tail), common::Stamp(3));
+  ASSERT_TRUE(fix && fix->utc_ns);
+  EXPECT_EQ(*fix->utc_ns, utc_ns(2025, 12, 31, 23, 59, 59.5));
+  // The next epoch's GGA comes before its RMC: same date would be a day early.
+  fix = builder.add(nmea("GPGGA,000000.50" + gga_tail), common::Stamp(4));
+  ASSERT_TRUE(fix && fix->utc_ns);
+  EXPECT_EQ(*fix->utc_ns, utc_ns(2026, 1, 1, 0, 0, 0.5));
+}
+
+TEST(GnssFixBuilder, EmitsAtGgaWithTheLastGstByDefault) {
+  GnssFixBuilder builder;
+  const std::string gga_tail = ",4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,";
+  const auto stamp = [](double s) { return common::Stamp::from_seconds(s); };
+  ASSERT_TRUE(builder.add(nmea("GPGGA,120001.00" + gga_tail), stamp(1.0)));
+  EXPECT_FALSE(builder.add(nmea("GPGST,120001.00,1.0,2.0,1.0,0.0,0.5,0.4,0.9"), stamp(1.01)));
+  // Epoch 2 goes out at its GGA, with epoch 1's GST (0.99 s old).
+  const auto fix = builder.add(nmea("GPGGA,120002.00" + gga_tail), stamp(2.0));
+  ASSERT_TRUE(fix);
+  EXPECT_EQ(fix->stamp, stamp(2.0));
+  EXPECT_NEAR(fix->covariance(2, 2), 0.9 * 0.9, 1e-12);
+  EXPECT_FALSE(builder.add(nmea("GPGST,120002.00,1.0,2.0,1.0,0.0,0.5,0.4,0.8"), stamp(2.01)));
+}
+
+TEST(GnssFixBuilder, WaitsForTheGstThatFollowsGgaOnceItHasSeenOne) {
+  GnssFixBuilderConfig config;
+  config.wait_for_gst = true;
+  GnssFixBuilder builder(config);
+  const std::string gga_tail = ",4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,";
+  const std::string gst_tail = ",1.0,2.0,1.0,0.0,0.5,0.4,0.9";
+  const auto stamp = [](double s) { return common::Stamp::from_seconds(s); };
+  // Epoch 1: nothing learned yet, GGA goes out at once with the HDOP covariance.
+  auto fix = builder.add(nmea("GPGGA,120001.00" + gga_tail), stamp(1.0));
+  ASSERT_TRUE(fix);
+  EXPECT_NEAR(fix->covariance(0, 0), 2.7 * 2.7, 1e-9);
+  EXPECT_FALSE(builder.add(nmea("GPGST,120001.00" + gst_tail), stamp(1.01)));
+  // Epoch 2: GGA is held, a VTG in between gives the velocity, GST completes it.
+  EXPECT_FALSE(builder.add(nmea("GPGGA,120002.00" + gga_tail), stamp(2.0)));
+  EXPECT_FALSE(builder.add(nmea("GPVTG,090.0,T,,M,,N,3.6,K"), stamp(2.005)));
+  fix = builder.add(nmea("GPGST,120002.00,1.0,2.0,1.0,0.0,0.25,0.3,0.8"), stamp(2.01));
+  ASSERT_TRUE(fix);
+  EXPECT_EQ(fix->stamp, stamp(2.0)) << "stamped when its GGA was read";
+  EXPECT_NEAR(fix->covariance(0, 0), 0.3 * 0.3, 1e-12);  // longitude sigma
+  EXPECT_NEAR(fix->covariance(1, 1), 0.25 * 0.25, 1e-12);
+  EXPECT_NEAR(fix->covariance(2, 2), 0.8 * 0.8, 1e-12);
+  ASSERT_TRUE(fix->velocity_enu);
+  EXPECT_NEAR(fix->velocity_enu->x(), 1.0, 1e-12);
+  // Epoch 3's GST never comes: the next epoch's RMC releases the fix (with the last GST) and
+  // the builder stops waiting.
+  EXPECT_FALSE(builder.add(nmea("GPGGA,120003.00" + gga_tail), stamp(3.0)));
+  fix =
+      builder.add(nmea("GPRMC,120004.00,A,4807.038,N,01131.000,E,0.0,0.0,010126,,,A"), stamp(4.0));
+  ASSERT_TRUE(fix);
+  EXPECT_EQ(fix->stamp, stamp(3.0));
+  EXPECT_NEAR(fix->covariance(2, 2), 0.8 * 0.8, 1e-12);
+  EXPECT_TRUE(builder.add(nmea("GPGGA,120004.00" + gga_tail), stamp(4.0)));
+}
+
+TEST(GnssFixBuilder, ModeFromGgaQuality) {
+  using common::FixMode;
+  EXPECT_EQ(mode_from_gga(0, true), FixMode::kNoFix);
+  EXPECT_EQ(mode_from_gga(1, true), FixMode::k3D);
+  EXPECT_EQ(mode_from_gga(1, false), FixMode::k2D);
+  EXPECT_EQ(mode_from_gga(2, true), FixMode::kDgps);
+  EXPECT_EQ(mode_from_gga(4, true), FixMode::kRtkFixed);
+  EXPECT_EQ(mode_from_gga(5, true), FixMode::kRtkFloat);
+  EXPECT_EQ(mode_from_gga(6, false), FixMode::k2D);
+  EXPECT_EQ(mode_from_gga(7, true), FixMode::kNoFix);
+  EXPECT_EQ(mode_from_gga(8, true), FixMode::kNoFix);
+  GnssFixBuilder builder;
+  const auto fix = builder.add(nmea("GNGGA,120001.00,4807.038,N,01131.000,E,5,08,0.9,,M,,M,,"),
+                               common::Stamp(1));
+  ASSERT_TRUE(fix);
+  EXPECT_EQ(fix->mode, FixMode::kRtkFloat);
+}
+
+TEST(GnssFixBuilder, NavPvtModeAndValidatedTime) {
+  using common::FixMode;
+  SemapUbxNavPvt p{};
+  p.year = 2021;
+  p.month = 6;
+  p.day = 10;
+  p.hour = 18;
+  p.min = 18;
+  p.sec = 56;
+  p.nano_ns = -1000;  // the second is rounded up: 18:18:55.999999
+  p.valid = SEMAP_UBX_PVT_VALID_DATE | SEMAP_UBX_PVT_VALID_TIME;
+  p.fix_type = 3;
+  p.flags = SEMAP_UBX_PVT_FLAG_GNSS_FIX_OK;
+  common::GnssFix fix = fix_from_nav_pvt(p, common::Stamp(1));
+  EXPECT_EQ(fix.mode, FixMode::k3D);
+  ASSERT_TRUE(fix.utc_ns);
+  EXPECT_EQ(*fix.utc_ns, utc_ns(2021, 6, 10, 18, 18, 56) - 1000);
+  p.valid = SEMAP_UBX_PVT_VALID_DATE;  // time not valid yet
+  EXPECT_FALSE(fix_from_nav_pvt(p, common::Stamp(1)).utc_ns);
+  p.fix_type = 2;
+  EXPECT_EQ(fix_from_nav_pvt(p, common::Stamp(1)).mode, FixMode::k2D);
+  p.fix_type = 3;
+  p.flags |= SEMAP_UBX_PVT_FLAG_DIFF_SOLN;
+  EXPECT_EQ(fix_from_nav_pvt(p, common::Stamp(1)).mode, FixMode::kDgps);
+  p.flags |= 1u << SEMAP_UBX_PVT_CARR_SOLN_SHIFT;
+  EXPECT_EQ(fix_from_nav_pvt(p, common::Stamp(1)).mode, FixMode::kRtkFloat);
+  p.flags = SEMAP_UBX_PVT_FLAG_GNSS_FIX_OK | (2u << SEMAP_UBX_PVT_CARR_SOLN_SHIFT);
+  EXPECT_EQ(fix_from_nav_pvt(p, common::Stamp(1)).mode, FixMode::kRtkFixed);
+  p.flags = 0;  // gnssFixOK clear
+  EXPECT_EQ(fix_from_nav_pvt(p, common::Stamp(1)).mode, FixMode::kNoFix);
+  p.flags = SEMAP_UBX_PVT_FLAG_GNSS_FIX_OK;
+  p.fix_type = 5;  // time only
+  EXPECT_EQ(fix_from_nav_pvt(p, common::Stamp(1)).mode, FixMode::kNoFix);
+}
+
+TEST(GnssFixBuilder, GstSigmasWinOverTheEllipseWhichGivesOnlyTheCorrelation) {
+  // A u-blox NEO-M9N GST (from the shared capture): a 95 % ellipse, 1-sigma lat/lon/alt.
+  const SemapNmeaSentence s = parse("$GNGST,223745.00,228650,2.5,2.4,126,0.98,1.0,3.1*41");
+  const Eigen::Matrix3d c = covariance_from_gst(s.u.gst);
+  EXPECT_NEAR(c(0, 0), 1.0, 1e-12);
+  EXPECT_NEAR(c(1, 1), 0.98 * 0.98, 1e-12);
+  EXPECT_NEAR(c(2, 2), 3.1 * 3.1, 1e-12);
+  // Major axis 126 deg from north (south-east): east and north errors anti-correlated,
+  // rho = (a^2 - b^2) sin t cos t / sqrt(E_ee E_nn) for the ellipse's own variances.
+  const double t = 126.0 * std::numbers::pi / 180.0;
+  const double ee = 6.25 * std::sin(t) * std::sin(t) + 5.76 * std::cos(t) * std::cos(t);
+  const double nn = 6.25 * std::cos(t) * std::cos(t) + 5.76 * std::sin(t) * std::sin(t);
+  const double rho = (6.25 - 5.76) * std::sin(t) * std::cos(t) / std::sqrt(ee * nn);
+  EXPECT_LT(rho, 0.0);
+  EXPECT_NEAR(c(0, 1), rho * 1.0 * 0.98, 1e-12);
+  EXPECT_EQ(c(0, 1), c(1, 0));
 }
 
 TEST(GnssFixBuilder, CombinesRmcVtgGstAndGgaOfOneEpoch) {
@@ -120,6 +277,9 @@ TEST(GnssEncoder, NmeaEpochRoundTripsThroughTheStreamDecoder) {
   ASSERT_TRUE(out.velocity_enu);
   EXPECT_NEAR((*out.velocity_enu - *in.velocity_enu).norm(), 0.0, 1e-3);
   EXPECT_EQ(decoder.counters().nmea_sentences, 4u);
+  ASSERT_TRUE(out.utc_ns);
+  EXPECT_EQ(*out.utc_ns, (1'767'225'600'000 + 45'296'700) * 1'000'000LL);
+  EXPECT_EQ(out.mode, common::FixMode::kRtkFloat);
 }
 
 TEST(GnssEncoder, UbxEpochRoundTrips) {
@@ -135,6 +295,9 @@ TEST(GnssEncoder, UbxEpochRoundTrips) {
   const common::GnssFix out = fix_from_nav_pvt(pvt, in.stamp);
   EXPECT_NEAR(out.latitude_deg, in.latitude_deg, 1e-7);
   EXPECT_EQ(out.quality, common::FixQuality::kRtkFloat);
+  EXPECT_EQ(out.mode, common::FixMode::kRtkFloat);
+  ASSERT_TRUE(out.utc_ns);
+  EXPECT_EQ(*out.utc_ns, 1'767'225'600'000 * 1'000'000LL);
   EXPECT_NEAR(out.covariance.trace(), in.covariance.trace(), 1e-3);
   EXPECT_NEAR((*out.velocity_enu - *in.velocity_enu).norm(), 0.0, 1e-3);
 }

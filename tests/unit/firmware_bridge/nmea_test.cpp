@@ -68,8 +68,9 @@ TEST(Nmea, ParsesRealRmcVtgAndGst) {
 }
 
 TEST(Nmea, AcceptsEveryListedTalkerAndRejectsOthers) {
-  const char* talkers[] = {"GP", "GN", "GL", "GA", "GB"};
-  for (int i = 0; i < 5; ++i) {
+  const char* talkers[] = {"GP", "GN", "GL", "GA", "GB", "BD", "GQ", "GI"};
+  ASSERT_EQ(std::size(talkers), std::size_t{SEMAP_NMEA_TALKER_COUNT});
+  for (int i = 0; i < SEMAP_NMEA_TALKER_COUNT; ++i) {
     SemapNmeaSentence s;
     const std::string sentence =
         with_checksum(std::string("$") + talkers[i] + "VTG,054.7,T,,M,005.5,N,010.2,K,A");
@@ -78,7 +79,9 @@ TEST(Nmea, AcceptsEveryListedTalkerAndRejectsOthers) {
     EXPECT_EQ(s.u.vtg.mode, 'A');
   }
   SemapNmeaSentence s;
-  EXPECT_EQ(parse(with_checksum("$BDVTG,054.7,T,,M,005.5,N,010.2,K,A"), s).status,
+  EXPECT_EQ(parse(with_checksum("$GXVTG,054.7,T,,M,005.5,N,010.2,K,A"), s).status,
+            SEMAP_FB_UNKNOWN);
+  EXPECT_EQ(parse(with_checksum("$QZVTG,054.7,T,,M,005.5,N,010.2,K,A"), s).status,
             SEMAP_FB_UNKNOWN);
   EXPECT_EQ(parse(with_checksum("$GPGSV,1,1,00"), s).status, SEMAP_FB_UNKNOWN);
   EXPECT_EQ(parse(with_checksum("$PUBX,00,081350.00"), s).status, SEMAP_FB_UNKNOWN);
@@ -101,13 +104,26 @@ TEST(Nmea, RejectsBadChecksumsAndAnyCorruptedCharacter) {
 
 TEST(Nmea, EnforcesTheLengthLimitAndStructure) {
   SemapNmeaSentence s;
-  // 80 characters plus CR LF is the longest legal sentence.
-  std::string body = "$GPGST,172814.0,0.006,0.023,0.020,273.6,0.023,0.020,0.031";
-  while (body.size() < 77) body += body.back() == ',' ? "0" : ",";
+  // 253 characters plus CR LF is the longest sentence accepted (NMEA 0183 itself says 82). A
+  // text sentence is well-formed but not decoded: UNKNOWN, not TOO_LONG.
+  std::string body = "$GPTXT,01,01,02,";
+  while (body.size() < 250) body += "x";
   const std::string longest = with_checksum(body);
-  ASSERT_EQ(longest.size(), 82u);
-  EXPECT_EQ(parse(longest, s).status, SEMAP_FB_OK);
-  EXPECT_EQ(parse(with_checksum(body + "0"), s).status, SEMAP_FB_TOO_LONG);
+  ASSERT_EQ(longest.size(), 255u);
+  EXPECT_EQ(parse(longest, s).status, SEMAP_FB_UNKNOWN);
+  EXPECT_EQ(parse(with_checksum(body + "x"), s).status, SEMAP_FB_TOO_LONG);
+  // Without CR LF the sentence itself may still use only 253.
+  EXPECT_EQ(parse(longest.substr(0, 253), s).status, SEMAP_FB_UNKNOWN);
+  EXPECT_EQ(parse(with_checksum(body + "x").substr(0, 254), s).status, SEMAP_FB_TOO_LONG);
+  // A high-precision receiver's GGA (8 decimals of minutes, 100 bytes) decodes.
+  const std::string precise = with_checksum(
+      "$GNGGA,123519.00,4807.03812345,N,01131.00012345,E,4,31,0.51,545.4321,M,46.9012,M,1.0,"
+      "0123");
+  ASSERT_GT(precise.size(), 82u);
+  ASSERT_EQ(parse(precise, s).status, SEMAP_FB_OK);
+  EXPECT_NEAR(s.u.gga.latitude_deg, 48.0 + 7.03812345 / 60.0, 1e-12);
+  EXPECT_NEAR(s.u.gga.longitude_deg, 11.0 + 31.00012345 / 60.0, 1e-12);
+  EXPECT_EQ(s.u.gga.quality, 4);
   EXPECT_EQ(parse("GPGGA,123519*47", s).status, SEMAP_FB_TRUNCATED);
   EXPECT_EQ(parse("$GPGGA,123519,4807.038,N,011", s).status, SEMAP_FB_TRUNCATED);
   EXPECT_EQ(parse("", s).status, SEMAP_FB_TRUNCATED);

@@ -202,5 +202,27 @@ TEST_F(BlockLogTest, CompactionKeepsTheLatestCopiesAndShrinksTheFile) {
   expect_equal(map, loaded);
 }
 
+TEST_F(BlockLogTest, TheMapFrameIsKeptOnceCommittedAndThroughCompaction) {
+  const MapFrame frame{49.01099547, 8.41599920, 114.58};
+  {
+    BlockLog log(dir_ / "map.log", params_);
+    log.set_frame(frame);  // not committed: a crash now forgets it
+  }
+  EXPECT_FALSE(BlockLog(dir_ / "map.log", params_).frame().has_value());
+  {
+    BlockLog log(dir_ / "map.log", params_);
+    log.set_frame(frame);
+    for (int round = 1; round <= 5; ++round) {
+      append_all(log, random_map(10));
+      log.commit(static_cast<std::uint64_t>(round));
+    }
+    ASSERT_TRUE(log.compact(2.0));
+  }
+  const BlockLog log(dir_ / "map.log", params_);
+  ASSERT_TRUE(log.frame().has_value());
+  EXPECT_EQ(*log.frame(), frame);
+  EXPECT_EQ(log.committed_scans(), 5u);
+}
+
 }  // namespace
 }  // namespace semap::mapping

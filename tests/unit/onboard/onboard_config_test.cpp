@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "dds_outputs.hpp"
 #include "segmenter_factory.hpp"
 #include "semap/common/config.hpp"
 
@@ -70,6 +71,11 @@ TEST(OnboardConfig, RgbdRobotExample) {
   EXPECT_FLOAT_EQ(c.depth.points.min_confidence, 0.5f);
   EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
   EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
+  // The shipped model's classes are the map's.
+  EXPECT_EQ(make_segmenter(c.segmenter, c.map.num_classes)->num_classes(), c.map.num_classes);
+  EXPECT_EQ(c.map_palette.names.size(), static_cast<std::size_t>(c.map.num_classes));
+  EXPECT_TRUE(c.map_resume);
+  EXPECT_GT(c.map_memory_radius_m, c.map.max_range);
   // Pitched 10 degrees down: the optical axis points forward and down.
   const Eigen::Vector3f axis = c.camera.body_from_optical().linear() * Eigen::Vector3f::UnitZ();
   EXPECT_GT(axis.x(), 0.98f);
@@ -83,6 +89,32 @@ TEST(OnboardConfig, StereoRobotExample) {
   EXPECT_EQ(c.depth.stereo.num_disparities, 64);
   EXPECT_EQ(c.camera.driver.format, common::PixelFormat::kMjpeg);
   EXPECT_EQ(c.camera.driver.width, 1280u);
+}
+
+TEST(OnboardConfig, MapPaletteNamesTheClassesInMapInfo) {
+  const auto c = load_onboard_config(kConfigDir / "sim.yaml");
+  ASSERT_EQ(c.map_palette.names.size(), 8u);
+  EXPECT_EQ(c.map_palette.names[3], "building");
+  EXPECT_EQ(c.map_palette.colors[1], (mapping::Rgb{128, 64, 128}));
+  const auto d = describe_map(c);
+  EXPECT_EQ(d.class_names, c.map_palette.names);
+  ASSERT_EQ(d.class_colors.size(), 8u);
+  EXPECT_EQ(d.class_colors[1], 0x804080u);
+}
+
+TEST(OnboardConfig, MapCheckpointAndMemoryRadius) {
+  const auto c = load_onboard_config(kConfigDir / "sim.yaml");
+  EXPECT_DOUBLE_EQ(c.map_checkpoint_s, 10.0);
+  EXPECT_FALSE(c.map_resume);
+  EXPECT_DOUBLE_EQ(c.map_memory_radius_m, 0.0);
+  // A radius a scan can reach beyond would split blocks between memory and the log.
+  const std::string too_small = error_of(
+      edited_sim("  save_path: build/sim_map.smap", "  save_path: x.smap\n  memory_radius_m: 5"));
+  EXPECT_NE(too_small.find("memory_radius_m"), std::string::npos) << too_small;
+  EXPECT_NE(too_small.find("max_range + ell + one block diagonal"), std::string::npos) << too_small;
+  const std::string no_log =
+      error_of(edited_sim("  checkpoint_s: 10", "  checkpoint_s: 0\n  memory_radius_m: 30"));
+  EXPECT_NE(no_log.find("needs the checkpoint log"), std::string::npos) << no_log;
 }
 
 TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {

@@ -28,6 +28,17 @@ enum class FixQuality : std::uint8_t {
   kDeadReckoning = 6,
 };
 
+// What kind of solution a fix is, as gpsd's mode (no fix / 2D / 3D) refined by the correction
+// in use. From GGA quality (2D when GGA has no altitude) or NAV-PVT fixType and flags.
+enum class FixMode : std::uint8_t {
+  kNoFix = 0,
+  k2D = 1,
+  k3D = 2,
+  kDgps = 3,
+  kRtkFloat = 4,
+  kRtkFixed = 5,
+};
+
 struct GnssFix {
   Stamp stamp;
   double latitude_deg = 0.0;
@@ -39,6 +50,11 @@ struct GnssFix {
   std::uint8_t satellites = 0;
   // Velocity in ENU, m/s, when the receiver reports it.
   std::optional<Eigen::Vector3d> velocity_enu;
+  FixMode mode = FixMode::kNoFix;
+  // The receiver's UTC time of the fix in ns since 1970-01-01T00:00:00Z (POSIX time: no leap
+  // seconds), when it reported both date and time: GGA time with the date of RMC, NAV-PVT date
+  // and time with validDate and validTime set.
+  std::optional<std::int64_t> utc_ns;
 
   bool valid() const { return quality != FixQuality::kInvalid; }
 };

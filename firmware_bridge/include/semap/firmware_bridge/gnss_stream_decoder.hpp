@@ -16,16 +16,22 @@ struct GnssStreamCounters {
   std::uint64_t garbage_bytes = 0;
   std::uint64_t nmea_sentences = 0;  // parsed and decoded
   std::uint64_t ubx_frames = 0;      // NAV-PVT decoded
-  std::uint64_t bad_checksum = 0;    // NMEA and UBX
+  std::uint64_t rtcm3_frames = 0;    // RTCM3 corrections, CRC-checked and skipped
+  std::uint64_t text_lines = 0;      // '#' comments and '{' JSON lines skipped
+  std::uint64_t bad_checksum = 0;    // NMEA, UBX and RTCM3
   std::uint64_t too_long = 0;
   std::uint64_t truncated = 0;
-  std::uint64_t unknown = 0;    // well-formed but not decoded (GSV, other UBX ids, ...)
+  // Well-formed but not decoded: GSV and other sentences, other UBX ids (also those too long to
+  // buffer, skipped as they arrive).
+  std::uint64_t unknown = 0;
   std::uint64_t bad_field = 0;  // checksum fine, a value malformed
   std::uint64_t fixes = 0;      // GnssFix produced
+
+  GnssStreamCounters& operator+=(const GnssStreamCounters& o);
 };
 
-// One serial byte stream (NMEA and UBX interleaved) to GnssFix: framer, parsers, fix builder
-// and counters of every rejection kind. Not thread-safe; one per device.
+// One serial byte stream (NMEA, UBX, RTCM3 and text lines interleaved) to GnssFix: framer,
+// parsers, fix builder and counters of every rejection kind. Not thread-safe; one per device.
 class GnssStreamDecoder {
  public:
   explicit GnssStreamDecoder(const GnssFixBuilderConfig& config = {});

@@ -12,15 +12,24 @@
 extern "C" {
 #endif
 
-/* NMEA 0183 limit: '$' through CR LF inclusive. */
-#define SEMAP_NMEA_MAX_LENGTH 82u
+/* NMEA 0183's limit, '$' through CR LF inclusive: what the encoders write. */
+#define SEMAP_NMEA_STANDARD_LENGTH 82u
+/* What the parser and the framer accept, '$' through CR LF inclusive. Real receivers exceed 82:
+ * high-precision ones print 7-8 decimals of minutes (GGA of 89-101 bytes) and NMEA 4.x lets
+ * proprietary sentences run longer. 255 covers both with room to spare and still bounds how
+ * long a line that lost its LF is buffered. */
+#define SEMAP_NMEA_MAX_LENGTH 255u
 
 typedef enum SemapNmeaTalker {
   SEMAP_NMEA_TALKER_GP = 0, /* GPS */
   SEMAP_NMEA_TALKER_GN,     /* multi-constellation */
   SEMAP_NMEA_TALKER_GL,     /* GLONASS */
   SEMAP_NMEA_TALKER_GA,     /* Galileo */
-  SEMAP_NMEA_TALKER_GB      /* BeiDou */
+  SEMAP_NMEA_TALKER_GB,     /* BeiDou (NMEA 4.10) */
+  SEMAP_NMEA_TALKER_BD,     /* BeiDou (older receivers, e.g. ST Teseo) */
+  SEMAP_NMEA_TALKER_GQ,     /* QZSS */
+  SEMAP_NMEA_TALKER_GI,     /* NavIC (IRNSS) */
+  SEMAP_NMEA_TALKER_COUNT
 } SemapNmeaTalker;
 
 typedef enum SemapNmeaType {
@@ -82,16 +91,17 @@ typedef struct SemapNmeaSentence {
   } u;
 } SemapNmeaSentence;
 
-/* Parses one sentence "$ttSSS,...*hh" with optional trailing CR LF. Returns TOO_LONG over 82
- * chars, TRUNCATED without '$' or "*hh", BAD_CHECKSUM on mismatch, UNKNOWN for another talker
- * or sentence, BAD_FIELD with the 0-based field index (after the address) of a bad value. */
+/* Parses one sentence "$ttSSS,...*hh" with optional trailing CR LF. Returns TOO_LONG over
+ * SEMAP_NMEA_MAX_LENGTH chars, TRUNCATED without '$' or "*hh", BAD_CHECKSUM on mismatch, UNKNOWN
+ * for another talker or sentence, BAD_FIELD with the 0-based field index (after the address) of a
+ * bad value. */
 SemapFbResult semap_nmea_parse(const char* text, size_t len, SemapNmeaSentence* out);
 
 /* XOR of the characters between '$' and '*' (exclusive). */
 uint8_t semap_nmea_checksum(const char* body, size_t len);
 
 /* Encoders: write "$..*hh\r\n" into buf and return its length (no terminating NUL counted),
- * or 0 when it does not fit in `cap` or SEMAP_NMEA_MAX_LENGTH. Fields with has_ == 0 are left
+ * or 0 when it does not fit in `cap` or SEMAP_NMEA_STANDARD_LENGTH. Fields with has_ == 0 are left
  * empty. A NUL is appended when room remains. */
 size_t semap_nmea_encode_gga(const SemapNmeaGga* in, SemapNmeaTalker talker, char* buf, size_t cap);
 size_t semap_nmea_encode_rmc(const SemapNmeaRmc* in, SemapNmeaTalker talker, char* buf, size_t cap);

@@ -1,9 +1,11 @@
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -24,6 +26,11 @@ class BlockLogError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Where the map's frame lies on the Earth: the geodetic origin (latitude and longitude in
+// degrees, altitude above the ellipsoid in m) of its local ENU frame. A resumed map is only
+// right in the same frame.
+using MapFrame = std::array<double, 3>;
+
 // Where each block's latest record lies in a log's bytes.
 struct BlockLogEntry {
   std::uint64_t offset = 0;  // of the record
@@ -36,6 +43,7 @@ struct BlockLogScan {
   std::unordered_map<common::BlockIndex, BlockLogEntry, common::BlockIndexHash> blocks;
   std::uint64_t committed_scans = 0;
   std::uint64_t commits = 0;
+  std::optional<MapFrame> frame;
   std::uint64_t end = 0;  // bytes up to and with the last commit (the header when none)
   // Why reading stopped before the end of the bytes ("" when it did not): a torn or damaged
   // record, with its byte offset.
@@ -53,6 +61,7 @@ BlockLogScan scan_block_log(std::span<const std::uint8_t> bytes, const MapParams
 //   header  "SEMAPLOG", version, method, cells per side, K, resolution, prior, sf2, ell, CRC
 //   block   type 1, length, x y z, scan, K * cells floats, observed words, CRC
 //   commit  type 2, length, scans, CRC
+//   frame   type 3, length, latitude, longitude, altitude (MapFrame), CRC
 // (little-endian, as the robot's CPU writes them). A commit says that the records before it
 // are the map after `scans` scans. A crash can only leave a torn tail after the last commit;
 // opening the log cuts it off, so the log resumes from the last complete checkpoint.
@@ -74,6 +83,9 @@ class BlockLog {
               std::span<const std::uint64_t> observed);
   // Appends a commit for the map after `scans` scans (fsyncs when durable).
   void commit(std::uint64_t scans);
+  // Records the map's frame (committed with the next commit).
+  void set_frame(const MapFrame& frame);
+  std::optional<MapFrame> frame() const;
   // Restores the latest copy of a block into `map` (SemanticMap::restore_block); false when the
   // log has none. Throws BlockLogError when the record cannot be read back.
   bool load(const common::BlockIndex& index, SemanticMap& map) const;
@@ -103,6 +115,7 @@ class BlockLog {
   std::unordered_map<common::BlockIndex, BlockLogEntry, common::BlockIndexHash> blocks_;
   std::uint64_t end_ = 0;
   std::uint64_t committed_scans_ = 0;
+  std::optional<MapFrame> frame_;
   std::string damage_;
 };
 

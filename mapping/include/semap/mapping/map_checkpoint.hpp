@@ -60,6 +60,9 @@ class MapCheckpoint {
   void flush();
 
   BlockLog& log() { return log_; }
+  // The map's frame as recorded in the log (a resumed map's), and recording it.
+  std::optional<MapFrame> frame() const { return log_.frame(); }
+  void set_frame(const MapFrame& frame) { log_.set_frame(frame); }
   Stats stats() const;
   // A damaged log tail cut on opening ("" when none).
   const std::string& damage() const { return log_.damage(); }
