@@ -74,7 +74,8 @@ int main(int argc, char** argv) {
     semap::apps::install_stop_handlers();
     const sd::Participant participant = dds.participant();
     map_cfg.ns = dds.settings().ns;
-    sd::MapPublisher map(participant, map_cfg, desc);
+    sd::SnapshotStore blocks;
+    sd::MapPublisher map(participant, map_cfg, desc, blocks);
     sd::Topic<sd::msg::Odometry> topic(
         participant, sd::topic_name(dds.settings().ns, sd::SemapTopic::kOdometry));
     sd::Writer<sd::msg::Odometry> odom(participant, topic,
@@ -107,7 +108,7 @@ int main(int argc, char** argv) {
       for (int dx = -1; dx <= 1; ++dx) {
         for (int dy = -1; dy <= 1; ++dy) {
           const semap::common::BlockIndex b{here.x + dx, here.y + dy, 0};
-          map.update(synthetic_block(b, desc, ++versions[b]));
+          map.changed(blocks.put(synthetic_block(b, desc, ++versions[b])));
         }
       }
       map.spin_once(pose.stamp);

@@ -1,11 +1,13 @@
 #include "dds_outputs.hpp"
 
+#include <chrono>
+
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/topic_names.hpp"
 
 namespace semap::onboard {
 
-DdsOutputs::DdsOutputs(const OnboardConfig& config)
+DdsOutputs::DdsOutputs(const OnboardConfig& config, const dds_idl::BlockSource& map_blocks)
     : config_(config),
       participant_(static_cast<dds_domainid_t>(config.dds.domain)),
       odometry_topic_(participant_,
@@ -19,7 +21,54 @@ DdsOutputs::DdsOutputs(const OnboardConfig& config)
       map_publisher_(participant_,
                      dds_idl::MapPublisherConfig{config.dds.ns, config.dds.frame_id,
                                                  config.dds.publish_hz, config.dds.cloud_hz},
-                     describe_map(config)) {}
+                     describe_map(config), map_blocks) {}
+
+DdsOutputs::~DdsOutputs() { stop(); }
+
+void DdsOutputs::start() {
+  publisher_thread_ = std::jthread([this](std::stop_token stop) { run_publisher(stop); });
+}
+
+void DdsOutputs::stop() {
+  if (!publisher_thread_.joinable()) return;
+  publisher_thread_.request_stop();
+  publisher_thread_.join();
+  // The last changes go out now rather than at the next round.
+  take_changed();
+  map_publisher_.publish_changed(common::Stamp::now());
+  update_counters();
+}
+
+void DdsOutputs::blocks_changed(const std::vector<common::BlockIndex>& blocks) {
+  std::lock_guard lock(changed_mutex_);
+  changed_.insert(blocks.begin(), blocks.end());
+}
+
+void DdsOutputs::take_changed() {
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed;
+  {
+    std::lock_guard lock(changed_mutex_);
+    changed.swap(changed_);
+  }
+  for (const auto& index : changed) map_publisher_.changed(index);
+}
+
+void DdsOutputs::update_counters() {
+  std::lock_guard lock(map_counters_mutex_);
+  map_counters_ = map_publisher_.counters();
+  map_pending_ = map_publisher_.pending();
+}
+
+void DdsOutputs::run_publisher(std::stop_token stop) {
+  // Rounds are due at the publisher's rates; this only bounds how late one starts.
+  constexpr auto kTick = std::chrono::milliseconds(20);
+  while (!stop.stop_requested()) {
+    take_changed();
+    map_publisher_.spin_once(common::Stamp::now());
+    update_counters();
+    std::this_thread::sleep_for(kTick);
+  }
+}
 
 void DdsOutputs::publish_pose(const PoseOutput& pose) {
   dds_idl::PoseEstimate p;
@@ -42,14 +91,6 @@ void DdsOutputs::publish_health(const dds_idl::HealthReport& report) {
   const dds_idl::HealthMessage m(report, config_.dds.frame_id);
   health_writer_.write(m.get());
   ++health_written_;
-}
-
-void DdsOutputs::publish_blocks(std::vector<dds_idl::BlockSnapshot>&& blocks, common::Stamp now) {
-  for (auto& b : blocks) map_publisher_.update(std::move(b));
-  map_publisher_.spin_once(now);
-  std::lock_guard lock(map_counters_mutex_);
-  map_counters_ = map_publisher_.counters();
-  map_pending_ = map_publisher_.pending();
 }
 
 std::size_t DdsOutputs::map_pending() const {

@@ -2,6 +2,8 @@
 
 #include <memory>
 #include <mutex>
+#include <thread>
+#include <unordered_set>
 #include <vector>
 
 #include "estimation_stage.hpp"
@@ -16,14 +18,23 @@
 
 namespace semap::onboard {
 
-// The robot's DDS side: odometry from the estimation stage, map blocks, MapInfo and map_cloud
-// from the mapping stage. Each stage calls only its own method, from its own thread.
+// The robot's DDS side: odometry from the estimation stage; map blocks, MapInfo and map_cloud
+// from the map publisher's own thread, which reads the blocks the mapping stage says changed
+// through its read-only view, at the configured rates, so a slow reader never holds up
+// mapping. Each stage calls only its own method, from its own thread.
 class DdsOutputs {
  public:
-  explicit DdsOutputs(const OnboardConfig& config);
+  // `map_blocks` (the mapping stage's view) outlives the publisher thread: stop() first.
+  DdsOutputs(const OnboardConfig& config, const dds_idl::BlockSource& map_blocks);
+  ~DdsOutputs();
+
+  // The map publisher's thread; stop() publishes what changed last before it returns.
+  void start();
+  void stop();
 
   void publish_pose(const PoseOutput& pose);
-  void publish_blocks(std::vector<dds_idl::BlockSnapshot>&& blocks, common::Stamp now);
+  // From the mapping thread: these blocks changed (cheap, never waits for DDS).
+  void blocks_changed(const std::vector<common::BlockIndex>& blocks);
   // From the main thread, at 1 Hz.
   void publish_health(const dds_idl::HealthReport& report);
 
@@ -41,11 +52,18 @@ class DdsOutputs {
   std::atomic<std::uint64_t> odometry_written_{0};
   dds_idl::Topic<dds_idl::msg::Health> health_topic_;
   dds_idl::Writer<dds_idl::msg::Health> health_writer_;
-  dds_idl::MapPublisher map_publisher_;
+  void run_publisher(std::stop_token stop);
+  void take_changed();
+  void update_counters();
+
+  dds_idl::MapPublisher map_publisher_;  // the publisher thread's
+  std::mutex changed_mutex_;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
   mutable std::mutex map_counters_mutex_;
   dds_idl::MapPublisherCounters map_counters_;
   std::size_t map_pending_ = 0;
   std::uint64_t health_written_ = 0;  // main thread only
+  std::jthread publisher_thread_;
 };
 
 }  // namespace semap::onboard

@@ -203,7 +203,6 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   }
 
   std::unique_ptr<onboard::DdsOutputs> dds;
-  if (config.dds.enabled) dds = std::make_unique<onboard::DdsOutputs>(config);
 
   std::filesystem::path checkpoint_path = config.map_checkpoint_path;
   if (checkpoint_path.empty() && !config.map_save_path.empty()) {
@@ -212,12 +211,16 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   if (checkpoint_path.empty() && report) checkpoint_path = report->dir() / "map.log";
   onboard::MappingStage mapping_stage(
       config, cloud_ring,
-      dds ? onboard::MappingStage::BlockSink(
-                [&](std::vector<dds_idl::BlockSnapshot>&& b, common::Stamp now) {
-                  dds->publish_blocks(std::move(b), now);
-                })
+      config.dds.enabled
+          ? onboard::MappingStage::BlockSink([&](const std::vector<common::BlockIndex>& changed) {
+              dds->blocks_changed(changed);
+            })
           : nullptr,
       checkpoint_path);
+  // The publisher reads the map through the mapping stage's view (it is set before the
+  // mapping thread starts).
+  if (config.dds.enabled)
+    dds = std::make_unique<onboard::DdsOutputs>(config, mapping_stage.blocks());
   // A resumed map lives in the frame it was built in: the estimator anchors there too.
   onboard::OnboardConfig estimation_config = config;
   if (const auto frame = mapping_stage.map_frame()) {
@@ -254,6 +257,7 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   }
   if (perception_stage) perception_stage->start();
   mapping_stage.start();
+  if (dds) dds->start();
   if (rig) rig->start();
   log->info("running{}", rig ? " on the simulated rig (GNSS via " + rig->gnss_device() + ")" : "");
 
@@ -317,6 +321,7 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   estimation_stage.stop();
   if (perception_stage) perception_stage->stop();
   mapping_stage.stop();
+  if (dds) dds->stop();  // the map's last changes go out
 
   const auto est = estimation_stage.stats();
   const auto map = mapping_stage.stats();

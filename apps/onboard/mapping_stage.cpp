@@ -116,14 +116,18 @@ void MappingStage::run(std::stop_token stop) {
   if (config_.map_resume && sink_) {
     // Subscribers get the resumed map before anything new.
     std::vector<common::BlockIndex> resumed;
-    map_.for_each_block(
-        [&](const common::BlockIndex& index, const mapping::Block&) { resumed.push_back(index); });
-    sink_(snapshots_of(resumed), common::Stamp::now());
+    if (pager_) {
+      resumed = checkpoint_->log().blocks();
+    } else {
+      map_.for_each_block([&](const common::BlockIndex& index, const mapping::Block&) {
+        resumed.push_back(index);
+      });
+    }
+    sink_(resumed);
   }
   common::LabeledCloud cloud;
   while (!stop.stop_requested()) {
     if (!clouds_.try_pop(cloud)) {
-      if (sink_) sink_({}, common::Stamp::now());  // lets the publisher keep its rates
       if (checkpoint_) checkpoint_->poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       continue;
@@ -134,37 +138,60 @@ void MappingStage::run(std::stop_token stop) {
 
 void MappingStage::insert(const common::LabeledCloud& cloud) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (pager_) pager_->update(cloud.origin);
-  const auto result = map_.insert(cloud, cloud.origin);
-  if (pager_) pager_->after_insert(result);
+  mapping::InsertResult result;
+  {
+    std::unique_lock lock(map_mutex_);
+    if (pager_) pager_->update(cloud.origin);
+    result = map_.insert(cloud, cloud.origin);
+    if (pager_) pager_->after_insert(result);
+    for (const auto& index : result.updated_blocks) ++versions_[index];
+  }
   if (checkpoint_) checkpoint_->after_insert(result);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
-  auto snapshots = snapshots_of(result.updated_blocks);
   local_.scans++;
   local_.points += cloud.size();
-  local_.blocks_changed += snapshots.size();
+  local_.blocks_changed += result.updated_blocks.size();
   local_.insert_seconds_total += seconds;
   local_.insert_seconds_max = std::max(local_.insert_seconds_max, seconds);
   local_.map = map_.stats();
   if (checkpoint_) local_.checkpoint = checkpoint_->stats();
   if (pager_) local_.pager = pager_->stats();
-  if (sink_) sink_(std::move(snapshots), common::Stamp::now());
+  if (sink_) sink_(result.updated_blocks);
   std::lock_guard lock(stats_mutex_);
   shared_ = local_;
 }
 
-std::vector<dds_idl::BlockSnapshot> MappingStage::snapshots_of(
-    const std::vector<common::BlockIndex>& updated) {
-  std::vector<dds_idl::BlockSnapshot> out;
-  out.reserve(updated.size());
-  for (const auto& index : updated) {
-    if (const auto* block = map_.find_block(index)) {
-      out.push_back(to_snapshot(map_, index, *block, ++versions_[index]));
-    }
+void MappingStage::for_each_block(const std::function<void(const common::BlockIndex&)>& f) const {
+  std::vector<common::BlockIndex> indices;
+  {
+    std::shared_lock lock(map_mutex_);
+    map_.for_each_block(
+        [&](const common::BlockIndex& index, const mapping::Block&) { indices.push_back(index); });
   }
-  return out;
+  for (const auto& index : indices) f(index);
+}
+
+bool MappingStage::read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const {
+  std::shared_lock lock(map_mutex_);
+  const auto version = versions_.find(index);
+  const std::uint32_t v = version == versions_.end() ? 0 : version->second;
+  if (const mapping::Block* block = map_.find_block(index)) {
+    out = to_snapshot(map_, index, *block, v);
+    return true;
+  }
+  // Paged out: the log holds its latest state.
+  std::vector<float> evidence;
+  std::vector<std::uint64_t> observed_words;
+  if (!pager_ || !checkpoint_->log().read(index, evidence, observed_words)) return false;
+  std::vector<std::uint8_t> observed(static_cast<std::size_t>(config_.map.cells_per_block()));
+  for (std::size_t c = 0; c < observed.size(); ++c) {
+    observed[c] = (observed_words[c / 64] >> (c % 64)) & 1u;
+  }
+  out = dds_idl::snapshot_of_evidence(index, config_.map.grid(), config_.map.num_classes, evidence,
+                                      observed, config_.map.prior, config_.map.unknown_variance, v);
+  return true;
 }
 
 }  // namespace semap::onboard

@@ -4,6 +4,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <shared_mutex>
 #include <thread>
 #include <unordered_map>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "semap/common/spsc_ring.hpp"
 #include "semap/dds_idl/block_snapshot.hpp"
 #include "semap/dds_idl/map_description.hpp"
+#include "semap/dds_idl/map_publisher.hpp"
 #include "semap/mapping/map_checkpoint.hpp"
 #include "semap/mapping/semantic_map.hpp"
 
@@ -22,7 +24,7 @@ namespace semap::onboard {
 struct MappingStageStats {
   std::uint64_t scans = 0;  // this run's
   std::uint64_t points = 0;
-  std::uint64_t blocks_changed = 0;  // block snapshots handed to the publisher
+  std::uint64_t blocks_changed = 0;  // block changes told to the publisher
   double insert_seconds_total = 0.0;
   double insert_seconds_max = 0.0;
   mapping::MapStats map;
@@ -30,13 +32,15 @@ struct MappingStageStats {
   mapping::MapPager::Stats pager;            // zeros without a memory radius
 };
 
-// Owns the SemanticMap on its own thread: inserts every posed cloud and hands a snapshot of
-// each block the insert wrote to the block sink (the DDS map publisher). With a checkpoint
-// path it keeps the map recoverable (MapCheckpoint) and, with a memory radius, bounded
-// (MapPager).
-class MappingStage {
+// Owns the SemanticMap on its own thread: inserts every posed cloud and tells the block sink
+// (the DDS map publisher) which blocks the insert wrote. The publisher reads them, on its own
+// thread and at its own rate, through blocks(): a read-only view of the map that shares a
+// lock with the inserts, so the map is held once. With a checkpoint path the stage keeps the
+// map recoverable (MapCheckpoint) and, with a memory radius, bounded (MapPager).
+class MappingStage : private dds_idl::BlockSource {
  public:
-  using BlockSink = std::function<void(std::vector<dds_idl::BlockSnapshot>&&, common::Stamp)>;
+  // Called on the mapping thread; must not block.
+  using BlockSink = std::function<void(const std::vector<common::BlockIndex>&)>;
 
   // Throws mapping::BlockLogError when the checkpoint log cannot be opened or belongs to a map
   // with other parameters (it is never overwritten).
@@ -51,6 +55,9 @@ class MappingStage {
   MappingStageStats stats() const;
   // Age of each cloud (its image's capture stamp) once it is in the map.
   const LatencyWindow& latency() const { return latency_; }
+  // The map's blocks as the publisher sends them; safe from any thread. A paged-out block is
+  // read from the checkpoint log; for_each_block lists the blocks in memory.
+  const dds_idl::BlockSource& blocks() const { return *this; }
   // Only after stop(): the map belongs to the stage thread while it runs. With a memory
   // radius, the whole map read back from the checkpoint log, else the map itself.
   const mapping::SemanticMap& map();
@@ -66,11 +73,15 @@ class MappingStage {
  private:
   void run(std::stop_token stop);
   void insert(const common::LabeledCloud& cloud);
-  std::vector<dds_idl::BlockSnapshot> snapshots_of(const std::vector<common::BlockIndex>& updated);
+  // BlockSource, for the publisher's thread.
+  void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const override;
+  bool read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
 
   const OnboardConfig& config_;
   common::SpscRing<common::LabeledCloud>& clouds_;
   BlockSink sink_;
+  // The mapping thread writes the map (and versions_) under an exclusive lock; readers share.
+  mutable std::shared_mutex map_mutex_;
   mapping::SemanticMap map_;
   std::unique_ptr<mapping::MapCheckpoint> checkpoint_;
   std::unique_ptr<mapping::MapPager> pager_;

@@ -238,7 +238,8 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds, double ra
   cfg.ns = ns;
   cfg.blocks_hz = 1e6;
   cfg.cloud_hz = 0.0;
-  sd::MapPublisher pub(p, cfg, description(cells));
+  sd::SnapshotStore pub_blocks;
+  sd::MapPublisher pub(p, cfg, description(cells), pub_blocks);
   reader.expect("ready");
   while (pub.matched_readers() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   // 1000 distinct blocks, rewritten in new versions as fast as the writer goes.
@@ -257,7 +258,7 @@ Throughput throughput(int domain, std::uint16_t cells, double seconds, double ra
     ++version;
     for (auto& b : blocks) {
       b.version = version;
-      pub.update(b);
+      pub.changed(pub_blocks.put(b));
     }
     written += pub.publish_changed(Stamp::now());
     if (rate > 0.0) {
@@ -334,7 +335,8 @@ Latency latency(int domain, std::uint16_t cells, int blocks_per_update, double s
   cfg.ns = ns;
   cfg.blocks_hz = 10.0;
   cfg.cloud_hz = 0.0;
-  sd::MapPublisher pub(p, cfg, description(cells));
+  sd::SnapshotStore pub_blocks;
+  sd::MapPublisher pub(p, cfg, description(cells), pub_blocks);
   reader.expect("ready");
   while (pub.matched_readers() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   // Let the reader's side of the match settle too, or the first round arrives as historical
@@ -344,7 +346,8 @@ Latency latency(int domain, std::uint16_t cells, int blocks_per_update, double s
   std::uint32_t version = 0;
   while (Clock::now() - start < std::chrono::duration<double>(seconds)) {
     ++version;
-    for (int i = 0; i < blocks_per_update; ++i) pub.update(block({i, 0, 0}, cells, version));
+    for (int i = 0; i < blocks_per_update; ++i)
+      pub.changed(pub_blocks.put(block({i, 0, 0}, cells, version)));
     pub.spin_once(Stamp::now());
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }

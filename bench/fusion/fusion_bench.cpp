@@ -8,7 +8,7 @@
 #include <random>
 
 #include "semap/fusion/block_layers.hpp"
-#include "semap/fusion/incremental_merge.hpp"
+#include "semap/mapping/incremental_merge.hpp"
 #include "semap/mapping/map_merge.hpp"
 
 namespace {
@@ -69,8 +69,8 @@ void BM_RemergeOneChangedBlock(benchmark::State& state) {
   const auto& layer = *robot.find_layer(2);
   const semap::common::BlockIndex changed{3, 3, 0};
   for (auto _ : state) {
-    const auto targets = semap::fusion::touched_blocks(changed, params(), params(), T);
-    semap::fusion::remerge_blocks(fused, 2, layer, params(), targets, T);
+    const auto targets = semap::mapping::touched_blocks(changed, params(), params(), T);
+    semap::mapping::remerge_blocks(fused, 2, layer, params(), targets, T);
     benchmark::DoNotOptimize(fused);
   }
   state.SetItemsProcessed(state.iterations());

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "semap/dds_idl/block_codec.hpp"
 #include "semap/dds_idl/topic_names.hpp"
@@ -17,8 +18,25 @@ common::Stamp after(common::Stamp now, double hz) {
 
 }  // namespace
 
+common::BlockIndex SnapshotStore::put(BlockSnapshot block) {
+  const common::BlockIndex index = block.index;
+  blocks_.insert_or_assign(index, std::move(block));
+  return index;
+}
+
+void SnapshotStore::for_each_block(const std::function<void(const common::BlockIndex&)>& f) const {
+  for (const auto& [index, block] : blocks_) f(index);
+}
+
+bool SnapshotStore::read(const common::BlockIndex& index, BlockSnapshot& out) const {
+  const auto it = blocks_.find(index);
+  if (it == blocks_.end()) return false;
+  out = it->second;  // vector copy-assignment keeps out's buffers
+  return true;
+}
+
 MapPublisher::MapPublisher(const Participant& participant, MapPublisherConfig config,
-                           MapDescription description)
+                           MapDescription description, const BlockSource& source)
     : config_(std::move(config)),
       description_(std::move(description)),
       block_topic_(participant, topic_name(config_.ns, SemapTopic::kMapBlocks)),
@@ -27,7 +45,8 @@ MapPublisher::MapPublisher(const Participant& participant, MapPublisherConfig co
       info_writer_(participant, info_topic_, topic_qos(SemapTopic::kMapInfo)),
       cloud_topic_(participant, topic_name(config_.ns, SemapTopic::kMapCloud)),
       cloud_writer_(participant, cloud_topic_, topic_qos(SemapTopic::kMapCloud)),
-      cloud_(config_.frame_id) {
+      cloud_(config_.frame_id),
+      source_(source) {
   if (config_.blocks_hz <= 0.0) throw std::invalid_argument("MapPublisher: blocks_hz must be > 0");
   if (description_.num_classes == 0) {
     throw std::invalid_argument("MapPublisher: num_classes must be > 0");
@@ -43,28 +62,13 @@ void MapPublisher::check_shape(const BlockSnapshot& block) const {
       block.argmax_class.size() == cells && block.variance.size() == cells &&
       (block.evidence.empty() || block.evidence.size() == cells * block.num_classes);
   if (!shape_ok) {
-    throw std::invalid_argument("MapPublisher::update: block shape differs from the map's");
+    throw std::invalid_argument("MapPublisher: block " + std::to_string(block.index.x) + "," +
+                                std::to_string(block.index.y) + "," +
+                                std::to_string(block.index.z) + " differs from the map's shape");
   }
 }
 
-void MapPublisher::mark_changed(const common::BlockIndex& index, bool inserted) {
-  if (inserted) info_dirty_ = true;
-  changed_.insert(index);
-}
-
-void MapPublisher::update(BlockSnapshot&& block) {
-  check_shape(block);
-  const common::BlockIndex index = block.index;
-  const bool inserted = blocks_.insert_or_assign(index, std::move(block)).second;
-  mark_changed(index, inserted);
-}
-
-void MapPublisher::update(const BlockSnapshot& block) {
-  check_shape(block);
-  auto [it, inserted] = blocks_.try_emplace(block.index);
-  it->second = block;  // vector copy-assignment keeps the old version's buffers
-  mark_changed(block.index, inserted);
-}
+void MapPublisher::changed(const common::BlockIndex& index) { changed_.insert(index); }
 
 std::size_t MapPublisher::spin_once(common::Stamp now) {
   std::size_t written = 0;
@@ -80,12 +84,20 @@ std::size_t MapPublisher::spin_once(common::Stamp now) {
 }
 
 std::size_t MapPublisher::publish_changed(common::Stamp now) {
+  for (const common::BlockIndex& index : changed_) {
+    if (known_.insert(index).second) info_dirty_ = true;
+  }
   if (info_dirty_) publish_info(now);
   std::size_t written = 0;
   // A round of blocks goes out as few full packets when the configuration batches writes
   // (the loopback XML does), and is flushed before returning so that nothing waits.
   for (auto it = changed_.begin(); it != changed_.end();) {
-    const BlockMessage m(blocks_.at(*it), now, config_.frame_id);
+    if (!source_.read(*it, scratch_)) {  // gone from the source: subscribers keep the last
+      it = changed_.erase(it);
+      continue;
+    }
+    check_shape(scratch_);
+    const BlockMessage m(scratch_, now, config_.frame_id);
     try {
       block_writer_.write_batched(m.get());
     } catch (const DdsError& e) {
@@ -104,23 +116,28 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
 
 void MapPublisher::publish_cloud(common::Stamp now) {
   cloud_.clear();
-  for (const auto& [index, block] : blocks_) cloud_.add_occupied(block);
+  source_.for_each_block([&](const common::BlockIndex& index) {
+    if (source_.read(index, scratch_)) cloud_.add_occupied(scratch_);
+  });
   cloud_writer_.write(cloud_.message(now));
   ++counters_.clouds_written;
 }
 
 void MapPublisher::publish_info(common::Stamp now) {
-  if (!blocks_.empty()) {
+  if (!known_.empty()) {
+    const common::MapGrid grid{description_.resolution, description_.block_cells};
+    const float side = description_.resolution * static_cast<float>(description_.block_cells);
     Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     Eigen::Vector3f hi = -lo;
-    for (const auto& [index, block] : blocks_) {
-      lo = lo.cwiseMin(block.origin());
-      hi = hi.cwiseMax(block.origin() + Eigen::Vector3f::Constant(block.block_side()));
+    for (const common::BlockIndex& index : known_) {
+      const Eigen::Vector3f origin = grid.block_origin(index);
+      lo = lo.cwiseMin(origin);
+      hi = hi.cwiseMax(origin + Eigen::Vector3f::Constant(side));
     }
     description_.min_bound = lo.cast<double>();
     description_.max_bound = hi.cast<double>();
   }
-  description_.num_blocks = static_cast<std::uint32_t>(blocks_.size());
+  description_.num_blocks = static_cast<std::uint32_t>(known_.size());
   ++description_.sequence;
   const MapInfoMessage m(description_, now, config_.frame_id);
   info_writer_.write(m.get());

@@ -276,7 +276,7 @@ std::optional<MapFrame> BlockLog::frame() const {
   return frame_;
 }
 
-std::vector<std::uint8_t> BlockLog::read(const BlockLogEntry& entry) const {
+std::vector<std::uint8_t> BlockLog::read_record(const BlockLogEntry& entry) const {
   std::vector<std::uint8_t> bytes(entry.bytes);
   if (::pread(fd_, bytes.data(), bytes.size(), static_cast<off_t>(entry.offset)) !=
       static_cast<ssize_t>(bytes.size())) {
@@ -290,20 +290,29 @@ std::vector<std::uint8_t> BlockLog::read(const BlockLogEntry& entry) const {
   return bytes;
 }
 
-bool BlockLog::load(const common::BlockIndex& index, SemanticMap& map) const {
+bool BlockLog::read(const common::BlockIndex& index, std::vector<float>& evidence,
+                    std::vector<std::uint64_t>& observed) const {
   std::vector<std::uint8_t> bytes;
   {
     std::lock_guard lock(mutex_);
     const auto it = blocks_.find(index);
     if (it == blocks_.end()) return false;
-    bytes = read(it->second);
+    bytes = read_record(it->second);
   }
   const std::size_t floats =
       static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
-  std::vector<float> evidence(floats);
-  std::vector<std::uint64_t> observed(observed_words(params_));
+  evidence.resize(floats);
+  observed.resize(observed_words(params_));
+  // After the record's type and length: x, y, z and the scan (20 bytes).
   std::memcpy(evidence.data(), bytes.data() + 8 + 20, floats * 4);
   std::memcpy(observed.data(), bytes.data() + 8 + 20 + floats * 4, observed.size() * 8);
+  return true;
+}
+
+bool BlockLog::load(const common::BlockIndex& index, SemanticMap& map) const {
+  std::vector<float> evidence;
+  std::vector<std::uint64_t> observed;
+  if (!read(index, evidence, observed)) return false;
   map.restore_block(index, evidence, observed);
   return true;
 }
@@ -339,7 +348,7 @@ bool BlockLog::compact(double factor) {
     at += frame.size();
   }
   for (const auto& [index, entry] : blocks_) {
-    put(read(entry));
+    put(read_record(entry));
     moved[index] = {at, entry.bytes, entry.scan};
     at += entry.bytes;
   }

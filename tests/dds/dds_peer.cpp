@@ -64,11 +64,12 @@ int map_pub(const Options& o, const sd::Participant& p) {
   cfg.ns = o.ns;
   cfg.blocks_hz = 10.0;
   cfg.cloud_hz = 1.0;
-  sd::MapPublisher pub(p, cfg, description(o));
+  sd::SnapshotStore pub_blocks;
+  sd::MapPublisher pub(p, cfg, description(o), pub_blocks);
   for (int i = 0; i < o.blocks; ++i) {
-    pub.update(sd::testing::make_block(sd::testing::grid_index(i),
-                                       static_cast<std::uint32_t>(o.version),
-                                       static_cast<std::uint16_t>(o.classes), o.evidence));
+    pub.changed(pub_blocks.put(
+        sd::testing::make_block(sd::testing::grid_index(i), static_cast<std::uint32_t>(o.version),
+                                static_cast<std::uint16_t>(o.classes), o.evidence)));
   }
   const auto start = std::chrono::steady_clock::now();
   std::cout << "published " << pub.publish_changed(Stamp::now()) << std::endl;
@@ -158,8 +159,10 @@ int types_pub(const Options& o, const sd::Participant& p) {
   sd::MapPublisherConfig cfg;
   cfg.ns = o.ns;
   cfg.cloud_hz = 20.0;
-  sd::MapPublisher map(p, cfg, description(o));
-  map.update(sd::testing::make_block({0, 0, 0}, 1, static_cast<std::uint16_t>(o.classes), false));
+  sd::SnapshotStore map_blocks;
+  sd::MapPublisher map(p, cfg, description(o), map_blocks);
+  map.changed(map_blocks.put(
+      sd::testing::make_block({0, 0, 0}, 1, static_cast<std::uint16_t>(o.classes), false)));
 
   const std::string frame = "map";
   const std::string imu_frame = "imu";

@@ -188,10 +188,14 @@ TEST_F(FusionTest, TwoRobotsWithAKnownOffsetFuseLikeTheMappingMerge) {
   const MapFusionConfig cfg = config("fuse");
   dds_idl::Participant robot1(test_domain()), robot2(test_domain()), node(test_domain()),
       planner(test_domain());
-  dds_idl::MapPublisher pub1(robot1, {cfg.robots[0].ns, "map", 20.0, 0.0}, description());
-  dds_idl::MapPublisher pub2(robot2, {cfg.robots[1].ns, "map", 20.0, 0.0}, description());
-  for (auto& b : kRobot1.blocks(1)) pub1.update(std::move(b));
-  for (auto& b : kRobot2.blocks(1)) pub2.update(std::move(b));
+  dds_idl::SnapshotStore pub1_blocks;
+  dds_idl::MapPublisher pub1(robot1, {cfg.robots[0].ns, "map", 20.0, 0.0}, description(),
+                             pub1_blocks);
+  dds_idl::SnapshotStore pub2_blocks;
+  dds_idl::MapPublisher pub2(robot2, {cfg.robots[1].ns, "map", 20.0, 0.0}, description(),
+                             pub2_blocks);
+  for (auto& b : kRobot1.blocks(1)) pub1.changed(pub1_blocks.put(std::move(b)));
+  for (auto& b : kRobot2.blocks(1)) pub2.changed(pub2_blocks.put(std::move(b)));
   pub1.publish_changed(common::Stamp::now());
   pub2.publish_changed(common::Stamp::now());
 
@@ -235,7 +239,7 @@ TEST_F(FusionTest, TwoRobotsWithAKnownOffsetFuseLikeTheMappingMerge) {
   // evidence stays, it is not added a second time.
   const auto overlap_block = common::MapGrid(kResolution, kCells).block_of(overlap);
   const std::uint32_t version_before = fused.blocks().at(overlap_block).version;
-  for (auto& b : kRobot1.blocks(2)) pub1.update(std::move(b));
+  for (auto& b : kRobot1.blocks(2)) pub1.changed(pub1_blocks.put(std::move(b)));
   pub1.publish_changed(common::Stamp::now());
   ASSERT_TRUE(run_until(fusion, fused,
                         [&] { return fused.blocks().at(overlap_block).version > version_before; }));
@@ -247,11 +251,12 @@ TEST_F(FusionTest, TwoRobotsWithAKnownOffsetFuseLikeTheMappingMerge) {
 TEST_F(FusionTest, BlocksWithoutEvidenceAreCountedNotFused) {
   const MapFusionConfig cfg = config("noev");
   dds_idl::Participant robot(test_domain()), node(test_domain());
-  dds_idl::MapPublisher pub(robot, {cfg.robots[0].ns, "map", 20.0, 0.0}, description());
+  dds_idl::SnapshotStore pub_blocks;
+  dds_idl::MapPublisher pub(robot, {cfg.robots[0].ns, "map", 20.0, 0.0}, description(), pub_blocks);
   auto plain = dds_idl::BlockSnapshot::empty({0, 0, 0}, kResolution, kCells, kClasses, false);
   plain.version = 1;
-  pub.update(plain);
-  pub.update(robot_block(1, {1, 0, 0}, 0, 1));
+  pub.changed(pub_blocks.put(plain));
+  pub.changed(pub_blocks.put(robot_block(1, {1, 0, 0}, 0, 1)));
   pub.publish_changed(common::Stamp::now());
 
   MapFusion fusion(node, cfg);

@@ -61,8 +61,9 @@ TEST_F(DdsTest, KilledAndRestartedListenerRecoversMap) {
   Participant participant(test_domain());
   MapPublisherConfig cfg;
   cfg.ns = ns;
-  MapPublisher pub(participant, cfg, test_description(4));
-  for (int i = 0; i < 120; ++i) pub.update(make_block(grid_index(i), 1, 4, true));
+  SnapshotStore pub_blocks;
+  MapPublisher pub(participant, cfg, test_description(4), pub_blocks);
+  for (int i = 0; i < 120; ++i) pub.changed(pub_blocks.put(make_block(grid_index(i), 1, 4, true)));
   pub.publish_changed(Stamp::now());
 
   {
@@ -72,7 +73,7 @@ TEST_F(DdsTest, KilledAndRestartedListenerRecoversMap) {
     listener.kill();  // SIGKILL: no goodbye, the writer learns only by lease expiry
   }
   // The map moves on while no listener runs.
-  for (int i = 0; i < 120; ++i) pub.update(make_block(grid_index(i), 2, 4, true));
+  for (int i = 0; i < 120; ++i) pub.changed(pub_blocks.put(make_block(grid_index(i), 2, 4, true)));
   EXPECT_EQ(pub.publish_changed(Stamp::now()), 120u);
 
   ChildProcess restarted(peer("map-listen", {"--ns", ns, "--blocks", "120", "--classes", "4",
@@ -170,20 +171,21 @@ TEST_F(DdsTest, PublisherSendsOnlyChangedBlocksAtItsRate) {
   cfg.ns = ns;
   cfg.blocks_hz = 2.0;
   cfg.cloud_hz = 0.0;
-  MapPublisher pub(participant, cfg, test_description(3));
+  SnapshotStore pub_blocks;
+  MapPublisher pub(participant, cfg, test_description(3), pub_blocks);
   MapClient client(participant, {ns, {}});
 
-  for (int i = 0; i < 20; ++i) pub.update(make_block(grid_index(i), 1, 3, false));
+  for (int i = 0; i < 20; ++i) pub.changed(pub_blocks.put(make_block(grid_index(i), 1, 3, false)));
   const Stamp t0 = Stamp::now();
   EXPECT_EQ(pub.spin_once(t0), 20u);
   ASSERT_TRUE(client.wait_for_blocks(20, seconds(10)));
   client.take_changed();
 
   // Three blocks change, one of them twice: the next round sends three, in the latest version.
-  pub.update(make_block(grid_index(1), 2, 3, false));
-  pub.update(make_block(grid_index(2), 2, 3, false));
-  pub.update(make_block(grid_index(3), 2, 3, false));
-  pub.update(make_block(grid_index(3), 3, 3, false));
+  pub.changed(pub_blocks.put(make_block(grid_index(1), 2, 3, false)));
+  pub.changed(pub_blocks.put(make_block(grid_index(2), 2, 3, false)));
+  pub.changed(pub_blocks.put(make_block(grid_index(3), 2, 3, false)));
+  pub.changed(pub_blocks.put(make_block(grid_index(3), 3, 3, false)));
   EXPECT_EQ(pub.spin_once(t0 + 0.1), 0u) << "rate limit: 2 Hz";
   EXPECT_EQ(pub.pending(), 3u);
   EXPECT_EQ(pub.spin_once(t0 + 0.6), 3u);
@@ -197,7 +199,9 @@ TEST_F(DdsTest, PublisherSendsOnlyChangedBlocksAtItsRate) {
   EXPECT_EQ(client.blocks().at(grid_index(3)).version, 3u);
   EXPECT_THAT(client.take_changed(),
               ::testing::UnorderedElementsAre(grid_index(1), grid_index(2), grid_index(3)));
-  EXPECT_THROW(pub.update(make_block({0, 0, 0}, 1, 4, false)), std::invalid_argument);
+  // A block of another shape (4 classes in a 3-class map) is refused when it is read.
+  pub.changed(pub_blocks.put(make_block({0, 0, 0}, 1, 4, false)));
+  EXPECT_THROW(pub.publish_changed(Stamp::now()), std::invalid_argument);
 }
 
 }  // namespace

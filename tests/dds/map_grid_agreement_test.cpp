@@ -67,10 +67,11 @@ TEST_F(DdsTest, RobotAndClientAgreeOnTheCellOfPointsAtBlockFaces) {
     description.resolution = resolution;
     description.block_cells = static_cast<std::uint16_t>(p.cells_per_side());
     description.num_classes = kClasses;
-    MapPublisher publisher(participant, {ns, "map", 20.0, 0.0}, description);
+    SnapshotStore publisher_blocks;
+    MapPublisher publisher(participant, {ns, "map", 20.0, 0.0}, description, publisher_blocks);
     std::size_t blocks = 0;
     map.for_each_block([&](const common::BlockIndex& index, const mapping::Block& block) {
-      publisher.update(onboard::to_snapshot(map, index, block, 1));
+      publisher.changed(publisher_blocks.put(onboard::to_snapshot(map, index, block, 1)));
       ++blocks;
     });
     publisher.publish_changed(common::Stamp::now());

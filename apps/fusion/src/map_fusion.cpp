@@ -1,12 +1,13 @@
 #include "semap/fusion/map_fusion.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 #include <unordered_set>
 
 #include "semap/common/logging.hpp"
 #include "semap/fusion/block_layers.hpp"
-#include "semap/fusion/incremental_merge.hpp"
+#include "semap/mapping/incremental_merge.hpp"
 
 namespace semap::fusion {
 
@@ -27,7 +28,7 @@ MapFusion::MapFusion(const dds_idl::Participant& participant, MapFusionConfig co
     : config_(std::move(config)),
       params_(layered_params(config_.description, config_.method, config_.prior)),
       fused_(params_),
-      publisher_(participant, config_.output, config_.description) {
+      publisher_(participant, config_.output, config_.description, *this) {
   if (config_.robots.empty()) throw std::invalid_argument("MapFusion: no robots to follow");
   robots_.reserve(config_.robots.size());
   for (std::size_t i = 0; i < config_.robots.size(); ++i) {
@@ -78,7 +79,8 @@ std::size_t MapFusion::merge_changed() {
     if (robot.changed.empty()) continue;
     std::unordered_set<common::BlockIndex, common::BlockIndexHash> targets;
     for (const auto& key : robot.changed) {
-      for (const auto& t : touched_blocks(key, params_, params_, robot.source.T_fused_robot)) {
+      for (const auto& t :
+           mapping::touched_blocks(key, params_, params_, robot.source.T_fused_robot)) {
         targets.insert(t);
       }
     }
@@ -86,18 +88,20 @@ std::size_t MapFusion::merge_changed() {
     // The same as mapping::merge_into of the robot's whole layer, but resampling only the fused
     // blocks the change reaches.
     const std::vector<common::BlockIndex> list(targets.begin(), targets.end());
-    remerge_blocks(fused_, robot.id, robot.layer, params_, list, robot.source.T_fused_robot);
+    mapping::remerge_blocks(fused_, robot.id, robot.layer, params_, list,
+                            robot.source.T_fused_robot);
     touched.insert(list.begin(), list.end());
     ++robot.counters.merges;
   }
   std::size_t handed = 0;
   for (const auto& key : touched) {
-    auto& version = versions_[key];
-    auto block = fused_snapshot(fused_, key, version + 1);
-    if (!block) continue;
-    ++version;
-    publisher_.update(std::move(*block));
-    ++handed;
+    const auto& layers = fused_.layers();
+    if (std::any_of(layers.begin(), layers.end(),
+                    [&](const auto& layer) { return layer.second.find_block(key) != nullptr; })) {
+      ++versions_[key];
+      publisher_.changed(key);
+      ++handed;
+    }
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -106,6 +110,18 @@ std::size_t MapFusion::merge_changed() {
   counters_.merge_seconds_total += seconds;
   counters_.merge_seconds_max = std::max(counters_.merge_seconds_max, seconds);
   return handed;
+}
+
+void MapFusion::for_each_block(const std::function<void(const common::BlockIndex&)>& f) const {
+  for (const common::BlockIndex& key : fused_.block_keys()) f(key);
+}
+
+bool MapFusion::read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const {
+  const auto version = versions_.find(index);
+  auto block = fused_snapshot(fused_, index, version == versions_.end() ? 0 : version->second);
+  if (!block) return false;
+  out = std::move(*block);
+  return true;
 }
 
 std::size_t MapFusion::spin_once(common::Stamp now) {

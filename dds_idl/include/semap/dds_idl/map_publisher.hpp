@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -30,29 +31,57 @@ struct MapPublisherCounters {
   std::uint64_t write_timeouts = 0;
 };
 
-// The mapping side of the map topics. The mapping stage hands over changed blocks with
-// update(); spin_once() writes the blocks changed since the last round at blocks_hz (each
-// block once, in its latest version), MapInfo when the map grew, and map_cloud at cloud_hz.
-// Not thread safe: call from one thread.
+// Where the publisher reads the blocks it sends: the map's own storage, read-only, so the
+// publisher holds no copy of the map. Called from the publisher's thread; a source over a map
+// that another thread writes locks against that writer.
+class BlockSource {
+ public:
+  virtual ~BlockSource() = default;
+  // Calls f(index) for every block there is now.
+  virtual void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const = 0;
+  // The block at `index` into `out`, reusing its buffers; false when there is none (any more).
+  virtual bool read(const common::BlockIndex& index, BlockSnapshot& out) const = 0;
+};
+
+// A BlockSource that keeps snapshots: for producers that hold no semap map (simulated blocks,
+// tests). Not thread safe.
+class SnapshotStore : public BlockSource {
+ public:
+  // Keeps `block`, replacing the version at its index; returns the index.
+  common::BlockIndex put(BlockSnapshot block);
+  std::size_t size() const { return blocks_.size(); }
+
+  void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const override;
+  bool read(const common::BlockIndex& index, BlockSnapshot& out) const override;
+
+ private:
+  std::unordered_map<common::BlockIndex, BlockSnapshot, common::BlockIndexHash> blocks_;
+};
+
+// The mapping side of the map topics. The producer says which blocks changed with changed();
+// spin_once() reads those from the source and writes them at blocks_hz (each block once, in
+// its latest version), MapInfo when the map grew, and map_cloud (every block's occupied cells)
+// at cloud_hz. Not thread safe: call from one thread.
 class MapPublisher {
  public:
+  // `source` outlives the publisher.
   MapPublisher(const Participant& participant, MapPublisherConfig config,
-               MapDescription description);
+               MapDescription description, const BlockSource& source);
 
-  // Throws std::invalid_argument when the block's shape differs from the description.
-  void update(BlockSnapshot&& block);
-  // The same for a block the caller keeps: copied into the buffers of the version it replaces,
-  // so a new version of a known block allocates nothing.
-  void update(const BlockSnapshot& block);
+  // Marks a block changed: it goes out in the next round, read from the source then.
+  void changed(const common::BlockIndex& index);
   // Writes what is due at `now`; returns the number of blocks written.
   std::size_t spin_once(common::Stamp now);
   // Writes all pending blocks now, regardless of the rate. A write timeout ends the round
-  // early (counted); other DDS failures throw DdsError.
+  // early (counted); other DDS failures throw DdsError. Throws std::invalid_argument when the
+  // source gives a block whose shape differs from the description.
   std::size_t publish_changed(common::Stamp now);
   void publish_cloud(common::Stamp now);
 
   std::size_t pending() const { return changed_.size(); }
-  std::size_t num_blocks() const { return blocks_.size(); }
+  // Blocks published so far (a block the source later drops, such as a paged-out one, stays
+  // with subscribers and counts).
+  std::size_t num_blocks() const { return known_.size(); }
   const MapPublisherCounters& counters() const { return counters_; }
   // Readers currently matched on map_blocks.
   std::uint32_t matched_readers() const { return block_writer_.matched(); }
@@ -60,8 +89,6 @@ class MapPublisher {
  private:
   void publish_info(common::Stamp now);
   void check_shape(const BlockSnapshot& block) const;
-  // Marks `index` changed; `inserted`: the map grew.
-  void mark_changed(const common::BlockIndex& index, bool inserted);
 
   MapPublisherConfig config_;
   MapDescription description_;
@@ -72,7 +99,9 @@ class MapPublisher {
   Topic<msg::PointCloud2> cloud_topic_;
   Writer<msg::PointCloud2> cloud_writer_;
   MapCloud cloud_;
-  std::unordered_map<common::BlockIndex, BlockSnapshot, common::BlockIndexHash> blocks_;
+  const BlockSource& source_;
+  BlockSnapshot scratch_;  // the block being written, its buffers reused
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> known_;
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
   bool info_dirty_ = true;
   common::Stamp next_blocks_;

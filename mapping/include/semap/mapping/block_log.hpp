@@ -89,6 +89,10 @@ class BlockLog {
   // Restores the latest copy of a block into `map` (SemanticMap::restore_block); false when the
   // log has none. Throws BlockLogError when the record cannot be read back.
   bool load(const common::BlockIndex& index, SemanticMap& map) const;
+  // The latest copy of a block (K * cells floats and its observed words); false when the log
+  // has none. Throws BlockLogError as load does.
+  bool read(const common::BlockIndex& index, std::vector<float>& evidence,
+            std::vector<std::uint64_t>& observed) const;
   // Restores every block; returns how many.
   std::size_t load_all(SemanticMap& map) const;
   // Rewrites the file with only the latest record of each block (temp + fsync + rename) when
@@ -105,7 +109,7 @@ class BlockLog {
 
  private:
   void write_at_end(std::span<const std::uint8_t> bytes);
-  std::vector<std::uint8_t> read(const BlockLogEntry& entry) const;
+  std::vector<std::uint8_t> read_record(const BlockLogEntry& entry) const;
 
   std::filesystem::path path_;
   MapParams params_;

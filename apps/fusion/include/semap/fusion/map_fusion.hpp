@@ -36,8 +36,9 @@ struct FusionCounters {
 // that robot's previous evidence, so the fused Dirichlet evidence is
 // alpha_0 + sum over robots of (alpha_r - alpha_0): every robot's evidence and the prior count
 // exactly once however often a block is resent.
-// Not thread safe: call from one thread.
-class MapFusion {
+// The publisher reads the fused blocks from the fused map itself (the fusion is their
+// BlockSource). Not thread safe: call from one thread.
+class MapFusion : private dds_idl::BlockSource {
  public:
   MapFusion(const dds_idl::Participant& participant, MapFusionConfig config);
 
@@ -64,6 +65,9 @@ class MapFusion {
 
   void take_blocks(Robot& robot);
   std::size_t merge_changed();
+  // BlockSource: the fused map's blocks, as published.
+  void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const override;
+  bool read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
 
   MapFusionConfig config_;
   mapping::LayeredMapParams params_;

@@ -1,23 +1,25 @@
-#include "semap/fusion/incremental_merge.hpp"
+#include "semap/mapping/incremental_merge.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <random>
 #include <unordered_set>
 
-#include "semap/fusion/block_layers.hpp"
 #include "semap/mapping/map_merge.hpp"
 
-namespace semap::fusion {
+namespace semap::mapping {
 namespace {
 
-mapping::LayeredMapParams params(float resolution, std::uint16_t cells) {
-  dds_idl::MapDescription d;
-  d.resolution = resolution;
-  d.block_cells = cells;
-  d.num_classes = 2;
-  return layered_params(d, mapping::MapMethod::kBki, 0.001);
+LayeredMapParams params(float resolution, int cells) {
+  LayeredMapParams p;
+  p.method = MapMethod::kBki;
+  p.resolution = resolution;
+  p.block_depth = std::countr_zero(static_cast<unsigned>(cells)) + 1;
+  p.num_classes = 2;
+  p.prior = 0.001;
+  return p;
 }
 
 bool contains(const std::vector<common::BlockIndex>& keys, const common::BlockIndex& k) {
@@ -35,9 +37,9 @@ Eigen::Isometry3d random_pose(std::mt19937& rng) {
   return T;
 }
 
-mapping::EvidenceGrid::Block random_block(std::size_t floats, std::mt19937& rng) {
+EvidenceGrid::Block random_block(std::size_t floats, std::mt19937& rng) {
   std::uniform_int_distribution<int> value(-3, 4);  // about a third of the cells stay empty
-  mapping::EvidenceGrid::Block b(floats);
+  EvidenceGrid::Block b(floats);
   for (float& v : b) v = static_cast<float>(std::max(0, value(rng)));
   return b;
 }
@@ -67,9 +69,9 @@ TEST(IncrementalMerge, BlockRangesCoverWhatResamplingWrites) {
   for (int trial = 0; trial < 40; ++trial) {
     const Eigen::Isometry3d T = random_pose(rng);
     const common::BlockIndex key{trial % 5 - 2, trial % 3, -1};
-    mapping::EvidenceGrid layer(p.block_side(), p.channels());
-    layer.put_block(key, mapping::EvidenceGrid::Block(layer.block_floats(), 1.0f));
-    const auto written = mapping::resample_layer(layer, p, p, T);
+    EvidenceGrid layer(p.block_side(), p.channels());
+    layer.put_block(key, EvidenceGrid::Block(layer.block_floats(), 1.0f));
+    const auto written = resample_layer(layer, p, p, T);
     const auto touched = touched_blocks(key, p, p, T);
     ASSERT_GT(written.size(), 0u);
     for (const auto& [k, block] : written.blocks()) {
@@ -86,7 +88,7 @@ TEST(IncrementalMerge, RemergingChangedBlocksEqualsMergeIntoTheWholeLayer) {
   std::mt19937 rng(11);
   for (int trial = 0; trial < 12; ++trial) {
     const Eigen::Isometry3d T = trial == 0 ? Eigen::Isometry3d::Identity() : random_pose(rng);
-    mapping::LayeredMap robot(p);
+    LayeredMap robot(p);
     auto& layer = robot.layer(2);
     for (int x = -2; x <= 2; ++x) {
       for (int y = 0; y <= 2; ++y) {
@@ -94,14 +96,14 @@ TEST(IncrementalMerge, RemergingChangedBlocksEqualsMergeIntoTheWholeLayer) {
       }
     }
     layer.set_updates(1);
-    mapping::LayeredMap fused(p);
+    LayeredMap fused(p);
     fused.layer(1).put_block({0, 0, 0}, random_block(layer.block_floats(), rng));  // robot 1
-    mapping::merge_into(fused, robot, T);
+    merge_into(fused, robot, T);
 
     // Three blocks change (one of them new, one emptied), and the incremental update runs.
     const std::vector<common::BlockIndex> changed{{0, 1, 0}, {3, 0, 0}, {-2, 2, 0}};
     for (const auto& k : changed) layer.put_block(k, random_block(layer.block_floats(), rng));
-    layer.put_block({-2, 2, 0}, mapping::EvidenceGrid::Block(layer.block_floats(), 0.0f));
+    layer.put_block({-2, 2, 0}, EvidenceGrid::Block(layer.block_floats(), 0.0f));
     layer.set_updates(2);
     std::unordered_set<common::BlockIndex, common::BlockIndexHash> targets;
     for (const auto& k : changed) {
@@ -109,13 +111,13 @@ TEST(IncrementalMerge, RemergingChangedBlocksEqualsMergeIntoTheWholeLayer) {
     }
     remerge_blocks(fused, 2, layer, p, {targets.begin(), targets.end()}, T);
 
-    mapping::LayeredMap expected(p);
+    LayeredMap expected(p);
     expected.layer(1) = *fused.find_layer(1);
-    mapping::merge_into(expected, robot, T);
+    merge_into(expected, robot, T);
     ASSERT_TRUE(*fused.find_layer(2) == *expected.find_layer(2)) << "trial " << trial;
     EXPECT_TRUE(fused == expected) << "trial " << trial;
   }
 }
 
 }  // namespace
-}  // namespace semap::fusion
+}  // namespace semap::mapping

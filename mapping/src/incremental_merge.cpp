@@ -1,4 +1,4 @@
-#include "semap/fusion/incremental_merge.hpp"
+#include "semap/mapping/incremental_merge.hpp"
 
 #include <cmath>
 #include <unordered_set>
@@ -6,7 +6,7 @@
 #include "semap/common/map_grid.hpp"
 #include "semap/mapping/map_merge.hpp"
 
-namespace semap::fusion {
+namespace semap::mapping {
 
 namespace {
 
@@ -46,15 +46,15 @@ std::vector<common::BlockIndex> blocks_between(const common::CellIndex& first,
   return out;
 }
 
-Eigen::Vector3d block_origin(const common::BlockIndex& key, const mapping::LayeredMapParams& p) {
+Eigen::Vector3d block_origin(const common::BlockIndex& key, const LayeredMapParams& p) {
   return Eigen::Vector3d(key.x, key.y, key.z) * p.block_size();
 }
 
 }  // namespace
 
 std::vector<common::BlockIndex> touched_blocks(const common::BlockIndex& key,
-                                               const mapping::LayeredMapParams& from,
-                                               const mapping::LayeredMapParams& to,
+                                               const LayeredMapParams& from,
+                                               const LayeredMapParams& to,
                                                const Eigen::Isometry3d& T_to_from) {
   const Eigen::Vector3d lo = block_origin(key, from);
   const Box box = transformed_box(lo, lo + Eigen::Vector3d::Constant(from.block_size()), T_to_from);
@@ -70,8 +70,8 @@ std::vector<common::BlockIndex> touched_blocks(const common::BlockIndex& key,
 }
 
 std::vector<common::BlockIndex> source_blocks(const common::BlockIndex& key,
-                                              const mapping::LayeredMapParams& from,
-                                              const mapping::LayeredMapParams& to,
+                                              const LayeredMapParams& from,
+                                              const LayeredMapParams& to,
                                               const Eigen::Isometry3d& T_to_from) {
   // The target block's cell centres span the block shrunk by half a cell on every side.
   const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * to.resolution);
@@ -90,12 +90,11 @@ std::vector<common::BlockIndex> source_blocks(const common::BlockIndex& key,
                         from.block_side());
 }
 
-void remerge_blocks(mapping::LayeredMap& fused, mapping::SourceId source,
-                    const mapping::EvidenceGrid& layer, const mapping::LayeredMapParams& from,
-                    const std::vector<common::BlockIndex>& targets,
+void remerge_blocks(LayeredMap& fused, SourceId source, const EvidenceGrid& layer,
+                    const LayeredMapParams& from, const std::vector<common::BlockIndex>& targets,
                     const Eigen::Isometry3d& T_to_from) {
-  const mapping::LayeredMapParams& to = fused.params();
-  mapping::EvidenceGrid needed(layer.block_side(), layer.channels());
+  const LayeredMapParams& to = fused.params();
+  EvidenceGrid needed(layer.block_side(), layer.channels());
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> taken;
   for (const auto& target : targets) {
     for (const auto& key : source_blocks(target, from, to, T_to_from)) {
@@ -103,8 +102,8 @@ void remerge_blocks(mapping::LayeredMap& fused, mapping::SourceId source,
       if (const auto* block = layer.find_block(key)) needed.put_block(key, *block);
     }
   }
-  mapping::EvidenceGrid rebuilt = mapping::resample_layer(needed, from, to, T_to_from);
-  mapping::EvidenceGrid& out = fused.layer(source);
+  EvidenceGrid rebuilt = resample_layer(needed, from, to, T_to_from);
+  EvidenceGrid& out = fused.layer(source);
   for (const auto& target : targets) {
     if (auto block = rebuilt.take_block(target)) {
       out.put_block(target, std::move(*block));
@@ -115,4 +114,4 @@ void remerge_blocks(mapping::LayeredMap& fused, mapping::SourceId source,
   out.set_updates(layer.updates());
 }
 
-}  // namespace semap::fusion
+}  // namespace semap::mapping
