@@ -52,14 +52,24 @@ function(semap_simd_tuned target)
 endfunction()
 
 # Every library folder, in dependency order: later folders may link earlier ones, never the
-# reverse.
-set(SEMAP_LIBRARIES common firmware_bridge drivers estimation perception mapping dds_idl)
+# reverse. map_io (file formats, exports, offline evaluation) sits on top of mapping and is
+# linked by the offline tools only, never by semap-onboard.
+set(SEMAP_LIBRARIES common firmware_bridge drivers estimation perception mapping map_io dds_idl)
+# Library folders that a narrow SEMAP_ONLY list must not include without another one.
+set(semap_map_io_needs mapping)
 foreach(lib IN LISTS SEMAP_LIBRARIES)
   if(SEMAP_ONLY STREQUAL "" OR lib IN_LIST SEMAP_ONLY)
     set(semap_wants_${lib} TRUE)
   else()
     set(semap_wants_${lib} FALSE)
   endif()
+endforeach()
+foreach(lib IN LISTS SEMAP_LIBRARIES)
+  foreach(dep IN LISTS semap_${lib}_needs)
+    if(semap_wants_${lib} AND NOT semap_wants_${dep})
+      message(FATAL_ERROR "SEMAP_ONLY lists ${lib} without ${dep}, which it links")
+    endif()
+  endforeach()
 endforeach()
 
 # semap_library(NAME SOURCES ... [PUBLIC_LIBS ...] [PRIVATE_LIBS ...])

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "semap/map_io/map_export.hpp"
 #include "semap/mapping/logodds_map.hpp"
-#include "semap/mapping/map_export.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/smap_io.hpp"
 
@@ -41,7 +41,7 @@ inline void run_logodds(const mapping::MapParams& params,
   for (const auto& cloud : clouds) rejected += map.insert(cloud).rejected;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const auto cells = mapping::occupied_cells(map.layers());
+  const auto cells = map_io::occupied_cells(map.layers());
   if (!run.out_voxels.empty()) {
     std::ofstream out(run.out_voxels);
     if (!out) throw std::runtime_error(run.out_voxels + ": cannot create");

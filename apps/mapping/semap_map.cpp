@@ -14,8 +14,8 @@
 #include "logodds_mode.hpp"
 #include "map_options.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/map_params.hpp"
-#include "semap/mapping/pcd_io.hpp"
 #include "semap/mapping/semantic_layers.hpp"
 #include "semap/mapping/semantic_map.hpp"
 
@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
                                                     static_cast<std::size_t>(threads));
     }
     std::vector<semap::common::LabeledCloud> clouds;
-    for (const auto& path : scans) clouds.push_back(semap::mapping::read_pcd(path).cloud);
+    for (const auto& path : scans) clouds.push_back(semap::map_io::read_pcd(path).cloud);
 
     if (logodds) {
       logodds_run.out_voxels = out_voxels;

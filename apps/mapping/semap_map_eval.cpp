@@ -12,13 +12,14 @@
 
 #include "map_options.hpp"
 #include "semap/common/logging.hpp"
-#include "semap/mapping/evaluation.hpp"
-#include "semap/mapping/label_noise.hpp"
-#include "semap/mapping/pcd_io.hpp"
+#include "semap/map_io/evaluation.hpp"
+#include "semap/map_io/label_noise.hpp"
+#include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/semantic_map.hpp"
 
 namespace {
 
+using namespace semap::map_io;
 using namespace semap::mapping;
 
 void print_label_noise(std::span<const semap::common::LabeledCloud> clean, const MapParams& base,

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "semap/mapping/map_export.hpp"
+#include "semap/map_io/map_export.hpp"
 #include "semap/mapping/smap_io.hpp"
 
 namespace {
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Export a .smap map to PLY, PCD, OctoMap (.ot) and top-down PNGs"};
   std::string in_path, ply, pcd, octomap, png, variance_png, palette_path, compare;
   bool salvage = false;
-  semap::mapping::TopDownOptions top_down;
+  semap::map_io::TopDownOptions top_down;
   app.add_option("input", in_path, "map (.smap)")->required();
   app.add_option("--ply", ply, "occupied cell centres, coloured by class (.ply)");
   app.add_option("--pcd", pcd, "occupied cell centres, coloured by class (.pcd)");
@@ -69,13 +69,13 @@ int main(int argc, char** argv) {
     const auto palette = palette_path.empty()
                              ? semap::mapping::ClassPalette::defaults(params.num_classes)
                              : semap::mapping::load_palette(palette_path, params.num_classes);
-    const auto cells = semap::mapping::occupied_cells(read.map);
-    if (!ply.empty()) semap::mapping::write_ply(ply, cells, palette);
-    if (!pcd.empty()) semap::mapping::write_cells_pcd(pcd, cells, palette);
-    if (!octomap.empty()) semap::mapping::write_octomap(octomap, cells, params.resolution, palette);
+    const auto cells = semap::map_io::occupied_cells(read.map);
+    if (!ply.empty()) semap::map_io::write_ply(ply, cells, palette);
+    if (!pcd.empty()) semap::map_io::write_cells_pcd(pcd, cells, palette);
+    if (!octomap.empty()) semap::map_io::write_octomap(octomap, cells, params.resolution, palette);
     if (!png.empty() || !variance_png.empty()) {
-      semap::mapping::write_top_down_pngs(png, variance_png, cells, params.resolution, palette,
-                                          top_down);
+      semap::map_io::write_top_down_pngs(png, variance_png, cells, params.resolution, palette,
+                                         top_down);
     }
     std::printf("method %s\nsources %zu\noccupied_cells %zu\n",
                 semap::mapping::to_string(params.method).c_str(), read.map.layers().size(),

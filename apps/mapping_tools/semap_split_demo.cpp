@@ -9,18 +9,19 @@
 #include <string>
 #include <vector>
 
+#include "semap/map_io/map_agreement.hpp"
+#include "semap/map_io/map_export.hpp"
+#include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/cloud_transform.hpp"
 #include "semap/mapping/logodds_map.hpp"
-#include "semap/mapping/map_agreement.hpp"
-#include "semap/mapping/map_export.hpp"
 #include "semap/mapping/map_merge.hpp"
-#include "semap/mapping/pcd_io.hpp"
 #include "semap/mapping/smap_io.hpp"
 #include "transform_option.hpp"
 
 namespace {
 
 using semap::common::LabeledCloud;
+using semap::map_io::occupied_agreement;
 using semap::mapping::LayeredMap;
 
 LayeredMap build(const semap::mapping::LayeredMapParams& params,
@@ -31,7 +32,7 @@ LayeredMap build(const semap::mapping::LayeredMapParams& params,
   return map.layers();
 }
 
-void print(const char* name, const semap::mapping::Agreement& a) {
+void print(const char* name, const semap::map_io::Agreement& a) {
   std::printf(
       "%s: reference occupied %zu, candidate occupied %zu, both %zu, same class %zu, "
       "agreement %.4f\n",
@@ -68,7 +69,7 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("--split must leave scans for both robots");
     }
     std::vector<LabeledCloud> all;
-    for (const auto& path : scan_paths) all.push_back(semap::mapping::read_pcd(path).cloud);
+    for (const auto& path : scan_paths) all.push_back(semap::map_io::read_pcd(path).cloud);
     const std::vector<LabeledCloud> first(all.begin(), all.begin() + split);
     const std::vector<LabeledCloud> second(all.begin() + split, all.end());
     const Eigen::Isometry3d T_bw = semap::apps::transform_from_values(b_frame);
@@ -98,9 +99,9 @@ int main(int argc, char** argv) {
     const auto palette = semap::mapping::ClassPalette::defaults(params.num_classes);
     for (const auto& [name, map] :
          {std::pair<const char*, const LayeredMap*>{"merged", &merged}, {"single", &single}}) {
-      semap::mapping::write_top_down_pngs(
+      semap::map_io::write_top_down_pngs(
           dir / (std::string(name) + "_top.png"), dir / (std::string(name) + "_variance.png"),
-          semap::mapping::occupied_cells(*map), params.resolution, palette);
+          semap::map_io::occupied_cells(*map), params.resolution, palette);
     }
     std::printf("wrote robot_a.smap robot_b.smap merged.smap single.smap and PNGs to %s\n",
                 out_dir.c_str());

@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "semap/mapping/pcd_io.hpp"
+#include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/semantic_map.hpp"
 #include "synthetic_lidar.hpp"
 
@@ -44,7 +44,7 @@ std::vector<LabeledCloud> load_toy() {
     const std::string path = std::string(SEMAP_SHARED_DATA_DIR) +
                              "/sim_unstructured_annotated/sim_unstructured_annotated_" +
                              std::to_string(i) + ".pcd";
-    clouds.push_back(semap::mapping::read_pcd(path).cloud);
+    clouds.push_back(semap::map_io::read_pcd(path).cloud);
   }
   return clouds;
 }

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "semap/map_io/map_export.hpp"
+#include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/logodds_map.hpp"
-#include "semap/mapping/map_export.hpp"
 #include "semap/mapping/map_merge.hpp"
-#include "semap/mapping/pcd_io.hpp"
 #include "semap/mapping/smap_io.hpp"
 
 namespace {
@@ -20,10 +20,10 @@ const std::vector<semap::common::LabeledCloud>& toy_scans() {
   static const auto scans = [] {
     std::vector<semap::common::LabeledCloud> out;
     for (int i = 1; i <= 12; ++i) {
-      out.push_back(semap::mapping::read_pcd(std::string(SEMAP_SHARED_DATA_DIR) +
-                                             "/sim_unstructured_annotated/"
-                                             "sim_unstructured_annotated_" +
-                                             std::to_string(i) + ".pcd")
+      out.push_back(semap::map_io::read_pcd(std::string(SEMAP_SHARED_DATA_DIR) +
+                                            "/sim_unstructured_annotated/"
+                                            "sim_unstructured_annotated_" +
+                                            std::to_string(i) + ".pcd")
                         .cloud);
     }
     return out;
@@ -92,7 +92,7 @@ BENCHMARK(BM_MergeRotated)->Unit(benchmark::kMillisecond);
 
 void BM_OccupiedCells(benchmark::State& state) {
   for (auto _ : state) {
-    benchmark::DoNotOptimize(semap::mapping::occupied_cells(toy_map()).size());
+    benchmark::DoNotOptimize(semap::map_io::occupied_cells(toy_map()).size());
   }
 }
 BENCHMARK(BM_OccupiedCells)->Unit(benchmark::kMillisecond);

@@ -125,9 +125,9 @@ std::optional<std::size_t> first_bad_float(const float* p, std::size_t n) {
 }
 
 // The per-cell checks as branch-free reductions over whole arrays, which the compiler
-// vectorises: per-cell early exits made validation the largest cost of receiving a block
-// (about 22 instructions a cell, more than Cyclone's own receive path). Only when one of these
-// fails does find_bad_cell look for the first offending value to name it.
+// vectorises: per-cell early exits would make validation the largest cost of receiving a
+// block. Only when one of these fails does find_bad_cell look for the first offending value to
+// name it.
 template <typename T>
 T max_of(const T* p, std::size_t n) {
   T m = 0;

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "semap/mapping/pcd_io.hpp"
+#include "semap/map_io/pcd_io.hpp"
 
 namespace semap::mapping {
 namespace {
@@ -68,10 +68,11 @@ TEST_F(SemapMapCli, WritesQueriesVoxelsAndInsertTime) {
   EXPECT_EQ(last.find('\n'), last.size() - 1);
   EXPECT_GT(std::stod(last.substr(15)), 0.0);
 
-  const std::size_t points = read_pcd(toy(1)).cloud.size() + read_pcd(toy(2)).cloud.size();
+  const std::size_t points =
+      map_io::read_pcd(toy(1)).cloud.size() + map_io::read_pcd(toy(2)).cloud.size();
   const auto queries = lines_of(q);
   ASSERT_EQ(queries.size(), points);
-  const auto scan1 = read_pcd(toy(1)).cloud;
+  const auto scan1 = map_io::read_pcd(toy(1)).cloud;
   std::size_t right = 0;
   for (std::size_t i = 0; i < scan1.size(); ++i) {
     const int label = std::stoi(queries[i]);

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "semap/mapping/pcd_io.hpp"
+#include "semap/map_io/pcd_io.hpp"
 
 namespace semap::mapping::testing {
 
@@ -11,9 +11,9 @@ namespace semap::mapping::testing {
 inline std::vector<common::LabeledCloud> toy_scans(int first, int last) {
   std::vector<common::LabeledCloud> scans;
   for (int i = first; i <= last; ++i) {
-    scans.push_back(read_pcd(std::string(SEMAP_SHARED_DATA_DIR) +
-                             "/sim_unstructured_annotated/sim_unstructured_annotated_" +
-                             std::to_string(i) + ".pcd")
+    scans.push_back(map_io::read_pcd(std::string(SEMAP_SHARED_DATA_DIR) +
+                                     "/sim_unstructured_annotated/sim_unstructured_annotated_" +
+                                     std::to_string(i) + ".pcd")
                         .cloud);
   }
   return scans;

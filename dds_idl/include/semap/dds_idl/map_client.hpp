@@ -27,7 +27,7 @@ struct MapClientConfig {
   BlockLimits limits;
   // false: blocks are taken by poll() on the caller's thread. true: Cyclone's receive thread
   // takes and checks each block as it arrives (a listener), so no application thread has to
-  // wake per sample; on two cores this keeps up with about 1.5x the block rate (docs/dds.md).
+  // wake per sample and the client keeps up with a higher block rate (docs/dds.md).
   bool take_on_receive = false;
 };
 

@@ -39,7 +39,7 @@ class Reader {
     for (;;) {
       // Non-null buffers make Cyclone deserialise into the samples of the previous take,
       // reusing their sequence and string buffers, where a loan allocates and frees every
-      // sequence of every sample (a quarter of the instructions to receive a map block).
+      // sequence of every sample.
       std::array<void*, kBatch> samples;
       for (std::size_t i = 0; i < kBatch; ++i) samples[i] = &(*storage_)[i];
       std::array<dds_sample_info_t, kBatch> infos{};

@@ -6,9 +6,9 @@
 namespace semap::mapping {
 
 // Zeroed storage for block evidence, carved from large anonymous mappings. A LiDAR scan
-// allocates about 100 MB of new blocks; from malloc that is one page fault per 4 KiB (about
-// 40 % of the insertion's CPU time). The mappings ask for transparent huge pages where the
-// kernel offers them (512 times fewer faults) and arrive zeroed, so new blocks cost no memset.
+// allocates about 100 MB of new blocks; from malloc that is one page fault per 4 KiB, a large
+// share of the insertion's time. The mappings ask for transparent huge pages where the kernel
+// offers them (512 times fewer faults) and arrive zeroed, so new blocks cost no memset.
 // Storage lives until the arena is destroyed; it is not movable piecewise.
 class BlockArena {
  public:

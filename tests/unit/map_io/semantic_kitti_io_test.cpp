@@ -1,11 +1,11 @@
-#include "semap/mapping/semantic_kitti_io.hpp"
+#include "semap/map_io/semantic_kitti_io.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -86,4 +86,4 @@ TEST_F(KittiFiles, MalformedFilesNameFileAndLine) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -1,4 +1,4 @@
-#include "semap/mapping/pcd_io.hpp"
+#include "semap/map_io/pcd_io.hpp"
 
 #include <charconv>
 #include <cstdint>
@@ -10,7 +10,7 @@
 
 #include "semap/common/logging.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 namespace {
 
@@ -425,4 +425,4 @@ void write_pcd(const std::filesystem::path& path, const common::LabeledCloud& cl
   if (!out) throw PcdError(path.string() + ": write failed");
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

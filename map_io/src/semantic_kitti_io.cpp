@@ -1,4 +1,4 @@
-#include "semap/mapping/semantic_kitti_io.hpp"
+#include "semap/map_io/semantic_kitti_io.hpp"
 
 #include <cstdio>
 #include <cstring>
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <unordered_map>
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 namespace {
 
@@ -157,4 +157,4 @@ common::LabeledCloud KittiSequence::scan(std::size_t index) const {
   return cloud;
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

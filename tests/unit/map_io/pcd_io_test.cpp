@@ -1,11 +1,11 @@
-#include "semap/mapping/pcd_io.hpp"
+#include "semap/map_io/pcd_io.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <functional>
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
 
 std::string error_of(const std::function<void()>& f) {
@@ -108,4 +108,4 @@ TEST(PcdIo, TruncatedBinaryDataIsAnError) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io

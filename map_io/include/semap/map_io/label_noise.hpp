@@ -5,10 +5,10 @@
 #include <vector>
 
 #include "semap/common/messages.hpp"
-#include "semap/mapping/evaluation.hpp"
+#include "semap/map_io/evaluation.hpp"
 #include "semap/mapping/map_params.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 // Replaces the hard labels of round(fraction * N) randomly chosen points with a different
 // class drawn uniformly from [first_class, num_classes). Deterministic for a given seed.
@@ -71,8 +71,8 @@ struct SoftLabelResult {
 // scan index), four maps built with `params` (method replaced), scored as
 // evaluate_label_noise does.
 std::vector<SoftLabelResult> evaluate_soft_labels(std::span<const common::LabeledCloud> clean,
-                                                  const MapParams& params,
+                                                  const mapping::MapParams& params,
                                                   std::span<const double> error_rates,
                                                   std::uint64_t seed);
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -1,13 +1,13 @@
-#include "semap/mapping/evaluation.hpp"
+#include "semap/map_io/evaluation.hpp"
 
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
 
-#include "semap/mapping/label_noise.hpp"
+#include "semap/map_io/label_noise.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 ConfusionMatrix::ConfusionMatrix(int num_classes)
     : k_(num_classes), counts_(static_cast<std::size_t>(num_classes) * (num_classes + 1), 0) {
@@ -57,7 +57,8 @@ double ConfusionMatrix::mean_iou(std::span<const int> classes) const {
   return n == 0 ? std::numeric_limits<double>::quiet_NaN() : sum / n;
 }
 
-ConfusionMatrix score_map(const SemanticMap& map, std::span<const common::LabeledCloud> scans) {
+ConfusionMatrix score_map(const mapping::SemanticMap& map,
+                          std::span<const common::LabeledCloud> scans) {
   ConfusionMatrix m(map.params().num_classes);
   for (const auto& scan : scans) {
     for (std::size_t i = 0; i < scan.size(); ++i) {
@@ -68,7 +69,7 @@ ConfusionMatrix score_map(const SemanticMap& map, std::span<const common::Labele
 }
 
 std::vector<NoiseResult> evaluate_label_noise(std::span<const common::LabeledCloud> clean,
-                                              const MapParams& params,
+                                              const mapping::MapParams& params,
                                               std::span<const double> noise, std::uint64_t seed) {
   // Scan points are hits, so class 0 (free) is never a true label and is not scored.
   std::vector<int> classes(static_cast<std::size_t>(params.num_classes - 1));
@@ -79,10 +80,10 @@ std::vector<NoiseResult> evaluate_label_noise(std::span<const common::LabeledClo
     for (std::size_t i = 0; i < noisy.size(); ++i) {
       flip_labels(noisy[i], fraction, 1, params.num_classes, seed + i);
     }
-    for (const Method method : {Method::kBki, Method::kCsm}) {
-      MapParams p = params;
+    for (const mapping::Method method : {mapping::Method::kBki, mapping::Method::kCsm}) {
+      mapping::MapParams p = params;
       p.method = method;
-      SemanticMap map(p);
+      mapping::SemanticMap map(p);
       for (const auto& scan : noisy) map.insert(scan, scan.origin);
       NoiseResult row{fraction, method, score_map(map, clean), 0.0};
       row.mean_iou = row.confusion.mean_iou(classes);
@@ -92,4 +93,4 @@ std::vector<NoiseResult> evaluate_label_noise(std::span<const common::LabeledClo
   return rows;
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

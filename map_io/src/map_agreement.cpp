@@ -1,15 +1,16 @@
-#include "semap/mapping/map_agreement.hpp"
+#include "semap/map_io/map_agreement.hpp"
 
 #include <stdexcept>
 #include <vector>
 
 #include "semap/mapping/cell_summary.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
-Agreement occupied_agreement(const LayeredMap& reference, const LayeredMap& candidate) {
-  const LayeredMapParams& pr = reference.params();
-  const LayeredMapParams& pc = candidate.params();
+Agreement occupied_agreement(const mapping::LayeredMap& reference,
+                             const mapping::LayeredMap& candidate) {
+  const mapping::LayeredMapParams& pr = reference.params();
+  const mapping::LayeredMapParams& pc = candidate.params();
   if (pr.method != pc.method || pr.num_classes != pc.num_classes ||
       pr.resolution != pc.resolution || pr.block_depth != pc.block_depth) {
     throw std::invalid_argument("occupied_agreement: maps differ in method, classes or grid");
@@ -24,12 +25,12 @@ Agreement occupied_agreement(const LayeredMap& reference, const LayeredMap& cand
     const bool cand_has = candidate.fused_block(key, cand_block);
     for (int cell = 0; cell < side * side * side; ++cell) {
       const std::span<const float> r(ref_block.data() + cell * channels, channels);
-      const CellSummary rs = summarize(pr, r);
+      const mapping::CellSummary rs = mapping::summarize(pr, r);
       if (!rs.known || !rs.occupied) continue;
       ++a.reference_occupied;
       if (!cand_has) continue;
-      const CellSummary cs =
-          summarize(pc, std::span<const float>(cand_block.data() + cell * channels, channels));
+      const mapping::CellSummary cs = mapping::summarize(
+          pc, std::span<const float>(cand_block.data() + cell * channels, channels));
       if (!cs.known || !cs.occupied) continue;
       ++a.both_occupied;
       if (cs.label == rs.label) ++a.same_class;
@@ -38,12 +39,12 @@ Agreement occupied_agreement(const LayeredMap& reference, const LayeredMap& cand
   for (const common::BlockIndex& key : candidate.block_keys()) {
     candidate.fused_block(key, cand_block);
     for (int cell = 0; cell < side * side * side; ++cell) {
-      const CellSummary cs =
-          summarize(pc, std::span<const float>(cand_block.data() + cell * channels, channels));
+      const mapping::CellSummary cs = mapping::summarize(
+          pc, std::span<const float>(cand_block.data() + cell * channels, channels));
       if (cs.known && cs.occupied) ++a.candidate_occupied;
     }
   }
   return a;
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

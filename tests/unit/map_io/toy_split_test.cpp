@@ -4,15 +4,17 @@
 
 #include <cstdio>
 
+#include "semap/map_io/map_agreement.hpp"
 #include "semap/mapping/cloud_transform.hpp"
 #include "semap/mapping/logodds_map.hpp"
-#include "semap/mapping/map_agreement.hpp"
 #include "semap/mapping/map_merge.hpp"
 #include "semap/mapping/semantic_layers.hpp"
 #include "toy_data.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
+
+using namespace semap::mapping;
 
 // Robot B's frame: a general rotation and a translation that is no multiple of the cell size.
 Eigen::Isometry3d t_b_world() {
@@ -24,7 +26,7 @@ Eigen::Isometry3d t_b_world() {
 
 LayeredMap logodds_map(const std::vector<common::LabeledCloud>& scans, SourceId robot,
                        const Eigen::Isometry3d& T) {
-  LogOddsMap map(testing::toy_logodds_params(), robot);
+  LogOddsMap map(mapping::testing::toy_logodds_params(), robot);
   for (const auto& scan : scans) map.insert(transform_cloud(scan, T.cast<float>()));
   return map.layers();
 }
@@ -32,8 +34,8 @@ LayeredMap logodds_map(const std::vector<common::LabeledCloud>& scans, SourceId 
 class ToySplit : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    first_ = new std::vector<common::LabeledCloud>(testing::toy_scans(1, 6));
-    second_ = new std::vector<common::LabeledCloud>(testing::toy_scans(7, 12));
+    first_ = new std::vector<common::LabeledCloud>(mapping::testing::toy_scans(1, 6));
+    second_ = new std::vector<common::LabeledCloud>(mapping::testing::toy_scans(7, 12));
   }
   static void TearDownTestSuite() {
     delete first_;
@@ -99,7 +101,7 @@ TEST_F(ToySplit, MergedLogOddsMapAgreesWithSingleRobotMap) {
 
 // S-BKI evidence is a sum over scans, so merging the two robots' maps is exact.
 TEST_F(ToySplit, MergedBkiMapEqualsSingleRobotMap) {
-  const LayeredMapParams toy = testing::toy_logodds_params();
+  const LayeredMapParams toy = mapping::testing::toy_logodds_params();
   MapParams p;
   p.resolution = 0.1f;
   p.block_depth = toy.block_depth;
@@ -133,4 +135,4 @@ TEST_F(ToySplit, MergedBkiMapEqualsSingleRobotMap) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -6,10 +6,10 @@
 #include <unordered_map>
 
 #include "semap/common/map_grid.hpp"
+#include "semap/map_io/map_export.hpp"
 #include "semap/mapping/atomic_file.hpp"
-#include "semap/mapping/map_export.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 namespace {
 
@@ -27,17 +27,17 @@ void write_png(const std::filesystem::path& path, const cv::Mat& image) {
   if (!cv::imencode(".png", image, bytes)) {
     throw std::runtime_error(path.string() + ": PNG encoding failed");
   }
-  write_file_atomically(path, bytes);
+  mapping::write_file_atomically(path, bytes);
 }
 
-cv::Scalar bgr(const Rgb& c) { return {double(c[2]), double(c[1]), double(c[0])}; }
+cv::Scalar bgr(const mapping::Rgb& c) { return {double(c[2]), double(c[1]), double(c[0])}; }
 
 }  // namespace
 
 void write_top_down_pngs(const std::filesystem::path& class_png,
                          const std::filesystem::path& variance_png,
                          const std::vector<OccupiedCell>& cells, double resolution,
-                         const ClassPalette& palette, const TopDownOptions& options) {
+                         const mapping::ClassPalette& palette, const TopDownOptions& options) {
   if (cells.empty()) throw std::runtime_error("top-down rendering: the map has no occupied cells");
   // Highest occupied cell of each (x, y) column.
   Eigen::Vector2i lo(std::numeric_limits<int>::max(), std::numeric_limits<int>::max());
@@ -111,4 +111,4 @@ void write_top_down_pngs(const std::filesystem::path& class_png,
   write_png(variance_png, canvas);
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -11,7 +11,7 @@
 
 #include "semap/common/messages.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 // A malformed SemanticKITTI file; the message names the file and, where it applies, the line.
 class KittiError : public std::runtime_error {
@@ -56,4 +56,4 @@ class KittiSequence {
   Eigen::Isometry3d velo_to_cam_;
 };
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

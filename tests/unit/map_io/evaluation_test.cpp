@@ -1,15 +1,17 @@
-#include "semap/mapping/evaluation.hpp"
+#include "semap/map_io/evaluation.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "semap/mapping/label_noise.hpp"
-#include "toy_dataset.hpp"
+#include "../mapping/toy_dataset.hpp"
+#include "semap/map_io/label_noise.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
+
+using namespace semap::mapping;
 
 TEST(ConfusionMatrix, IouCountsUnknownAsAMiss) {
   ConfusionMatrix m(3);
@@ -69,7 +71,7 @@ TEST(Evaluation, BkiFillsTheGapBetweenSparseHitsThatCsmLeavesUnknown) {
 }
 
 TEST(Evaluation, BkiBeatsCsmOnTheToyDatasetAtEveryNoiseLevel) {
-  const std::vector<common::LabeledCloud> scans = testing::toy_scans(1, 12);
+  const std::vector<common::LabeledCloud> scans = mapping::testing::toy_scans(1, 12);
   const std::vector<double> noise{0.0, 0.3, 0.5};
   const auto rows = evaluate_label_noise(scans, MapParams{}, noise, 1);
   ASSERT_EQ(rows.size(), 6u);
@@ -85,4 +87,4 @@ TEST(Evaluation, BkiBeatsCsmOnTheToyDatasetAtEveryNoiseLevel) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -6,12 +6,14 @@
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
 
+#include "semap/map_io/map_export.hpp"
+#include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/logodds_map.hpp"
-#include "semap/mapping/map_export.hpp"
-#include "semap/mapping/pcd_io.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
+
+using namespace semap::mapping;
 
 class Export : public ::testing::Test {
  protected:
@@ -137,4 +139,4 @@ TEST_F(Export, TopDownPngsShowTopClassAndLegend) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io

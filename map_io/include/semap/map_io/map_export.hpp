@@ -7,30 +7,30 @@
 #include "semap/mapping/class_palette.hpp"
 #include "semap/mapping/layered_map.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 // One occupied cell as exported.
 struct OccupiedCell {
   Eigen::Vector3d centre;
   int label = 0;
   float probability = 0.0f;  // of `label`
-  float variance = 0.0f;     // of `label`'s probability (see CellSummary)
+  float variance = 0.0f;     // of `label`'s probability (see mapping::CellSummary)
 };
 
 // Occupied cells of the fused map, sorted by position (stable output for equal maps).
-std::vector<OccupiedCell> occupied_cells(const LayeredMap& map);
+std::vector<OccupiedCell> occupied_cells(const mapping::LayeredMap& map);
 
 // Binary little-endian PLY: x y z (float), red green blue (uchar), label (int),
 // probability and variance (float). Opens in CloudCompare, MeshLab, Open3D.
 void write_ply(const std::filesystem::path& path, const std::vector<OccupiedCell>& cells,
-               const ClassPalette& palette);
+               const mapping::ClassPalette& palette);
 // Binary PCD v0.7: x y z rgb (packed float, PCL convention), label (uint32), probability and
 // variance (float).
 void write_cells_pcd(const std::filesystem::path& path, const std::vector<OccupiedCell>& cells,
-                     const ClassPalette& palette);
+                     const mapping::ClassPalette& palette);
 // OctoMap ColorOcTree (.ot) at `resolution`, occupied cells coloured by class, for octovis.
 void write_octomap(const std::filesystem::path& path, const std::vector<OccupiedCell>& cells,
-                   double resolution, const ClassPalette& palette);
+                   double resolution, const mapping::ClassPalette& palette);
 
 struct TopDownOptions {
   int pixels_per_cell = 4;
@@ -43,6 +43,6 @@ struct TopDownOptions {
 void write_top_down_pngs(const std::filesystem::path& class_png,
                          const std::filesystem::path& variance_png,
                          const std::vector<OccupiedCell>& cells, double resolution,
-                         const ClassPalette& palette, const TopDownOptions& options = {});
+                         const mapping::ClassPalette& palette, const TopDownOptions& options = {});
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -5,11 +5,13 @@
 #include <stdexcept>
 #include <vector>
 
-#include "semap/mapping/label_noise.hpp"
-#include "toy_dataset.hpp"
+#include "../mapping/toy_dataset.hpp"
+#include "semap/map_io/label_noise.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 namespace {
+
+using namespace semap::mapping;
 
 // n points, true classes cycling through 1..3 (K = 4, class 0 free).
 common::LabeledCloud cloud_of(std::size_t n) {
@@ -123,7 +125,7 @@ TEST(SoftLabelNoise, RejectsBadInput) {
 }
 
 TEST(SoftLabelNoise, SoftLabelsBeatTheirArgmaxUnderHeavyNoiseOnTheToyDataset) {
-  const std::vector<common::LabeledCloud> scans = testing::toy_scans(1, 12);
+  const std::vector<common::LabeledCloud> scans = mapping::testing::toy_scans(1, 12);
   const std::vector<double> errors{0.3, 0.5};
   const auto rows = evaluate_soft_labels(scans, MapParams{}, errors, 1);
   ASSERT_EQ(rows.size(), 2u);
@@ -137,4 +139,4 @@ TEST(SoftLabelNoise, SoftLabelsBeatTheirArgmaxUnderHeavyNoiseOnTheToyDataset) {
 }
 
 }  // namespace
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -1,4 +1,4 @@
-#include "semap/mapping/label_noise.hpp"
+#include "semap/map_io/label_noise.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 namespace {
 
@@ -158,16 +158,16 @@ SoftLabelNoise calibrated_soft_label_noise(double error, int classes) {
 }
 
 std::vector<SoftLabelResult> evaluate_soft_labels(std::span<const common::LabeledCloud> clean,
-                                                  const MapParams& params,
+                                                  const mapping::MapParams& params,
                                                   std::span<const double> error_rates,
                                                   std::uint64_t seed) {
   // Scan points are hits: classes 1..K-1 are the candidates and the scored classes.
   std::vector<int> classes(static_cast<std::size_t>(params.num_classes - 1));
   std::iota(classes.begin(), classes.end(), 1);
-  const auto miou = [&](Method method, const std::vector<common::LabeledCloud>& scans) {
-    MapParams p = params;
+  const auto miou = [&](mapping::Method method, const std::vector<common::LabeledCloud>& scans) {
+    mapping::MapParams p = params;
     p.method = method;
-    SemanticMap map(p);
+    mapping::SemanticMap map(p);
     for (const auto& scan : scans) map.insert(scan, scan.origin);
     return score_map(map, clean).mean_iou(classes);
   };
@@ -186,13 +186,13 @@ std::vector<SoftLabelResult> evaluate_soft_labels(std::span<const common::Labele
       hard.push_back(std::move(s.hard));
     }
     row.error = points == 0 ? 0.0 : static_cast<double>(wrong) / static_cast<double>(points);
-    row.bki_hard = miou(Method::kBki, hard);
-    row.bki_soft = miou(Method::kBki, soft);
-    row.csm_hard = miou(Method::kCsm, hard);
-    row.csm_soft = miou(Method::kCsm, soft);
+    row.bki_hard = miou(mapping::Method::kBki, hard);
+    row.bki_soft = miou(mapping::Method::kBki, soft);
+    row.csm_hard = miou(mapping::Method::kCsm, hard);
+    row.csm_soft = miou(mapping::Method::kCsm, soft);
     rows.push_back(row);
   }
   return rows;
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

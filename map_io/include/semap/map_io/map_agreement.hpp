@@ -4,7 +4,7 @@
 
 #include "semap/mapping/layered_map.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 // How well `candidate` reproduces `reference` on the same grid: of the cells occupied in the
 // reference, how many are occupied in the candidate with the same most probable class.
@@ -20,6 +20,7 @@ struct Agreement {
 };
 
 // Throws std::invalid_argument unless both maps share method, classes and grid.
-Agreement occupied_agreement(const LayeredMap& reference, const LayeredMap& candidate);
+Agreement occupied_agreement(const mapping::LayeredMap& reference,
+                             const mapping::LayeredMap& candidate);
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -8,7 +8,7 @@
 
 #include "semap/common/messages.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 // A malformed PCD file; the message names the file and, where it applies, the line.
 class PcdError : public std::runtime_error {
@@ -38,4 +38,4 @@ void write_pcd(const std::filesystem::path& path, const common::LabeledCloud& cl
                PcdEncoding encoding = PcdEncoding::kAscii);
 std::string format_pcd(const common::LabeledCloud& cloud, PcdEncoding encoding);
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

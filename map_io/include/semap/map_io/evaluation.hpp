@@ -7,7 +7,7 @@
 #include "semap/common/messages.hpp"
 #include "semap/mapping/semantic_map.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 // Per-class confusion counts of predicted against true labels, as in the SemanticKITTI
 // benchmark. A prediction of -1 (the map knows nothing there) counts as a miss of the true
@@ -35,13 +35,14 @@ class ConfusionMatrix {
 };
 
 // Queries `map` at every point of `scans` and compares with their labels.
-ConfusionMatrix score_map(const SemanticMap& map, std::span<const common::LabeledCloud> scans);
+ConfusionMatrix score_map(const mapping::SemanticMap& map,
+                          std::span<const common::LabeledCloud> scans);
 
 // One row of the label-noise study: a map built from scans whose labels were flipped, scored
 // at the scan points against the clean labels over the occupied classes 1..K-1.
 struct NoiseResult {
   double noise = 0.0;
-  Method method = Method::kBki;
+  mapping::Method method = mapping::Method::kBki;
   ConfusionMatrix confusion{1};
   double mean_iou = 0.0;
 };
@@ -50,7 +51,7 @@ struct NoiseResult {
 // (seed + scan index), build the map with `params` (method replaced), score it. Rows come
 // in the order noise-major, S-BKI before S-CSM.
 std::vector<NoiseResult> evaluate_label_noise(std::span<const common::LabeledCloud> clean,
-                                              const MapParams& params,
+                                              const mapping::MapParams& params,
                                               std::span<const double> noise, std::uint64_t seed);
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -3,13 +3,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "semap/map_io/map_export.hpp"
 #include "semap/mapping/atomic_file.hpp"
-#include "semap/mapping/map_export.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 void write_octomap(const std::filesystem::path& path, const std::vector<OccupiedCell>& cells,
-                   double resolution, const ClassPalette& palette) {
+                   double resolution, const mapping::ClassPalette& palette) {
   octomap::ColorOcTree tree(resolution);
   for (const OccupiedCell& c : cells) {
     const octomap::point3d p(static_cast<float>(c.centre.x()), static_cast<float>(c.centre.y()),
@@ -19,15 +19,15 @@ void write_octomap(const std::filesystem::path& path, const std::vector<Occupied
     if (node == nullptr) {
       throw std::runtime_error(path.string() + ": cell outside the octree's range");
     }
-    const Rgb rgb = palette.color(c.label);
+    const mapping::Rgb rgb = palette.color(c.label);
     node->setColor(rgb[0], rgb[1], rgb[2]);
   }
   tree.updateInnerOccupancy();
   std::ostringstream stream(std::ios::binary);
   if (!tree.write(stream)) throw std::runtime_error(path.string() + ": octomap serialisation");
   const std::string bytes = stream.str();
-  write_file_atomically(
+  mapping::write_file_atomically(
       path, std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()));
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io

@@ -1,4 +1,4 @@
-#include "semap/mapping/map_export.hpp"
+#include "semap/map_io/map_export.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -8,7 +8,7 @@
 #include "semap/mapping/atomic_file.hpp"
 #include "semap/mapping/cell_summary.hpp"
 
-namespace semap::mapping {
+namespace semap::map_io {
 
 namespace {
 
@@ -24,8 +24,8 @@ void append_text(std::vector<std::uint8_t>& out, const std::string& text) {
 
 }  // namespace
 
-std::vector<OccupiedCell> occupied_cells(const LayeredMap& map) {
-  const LayeredMapParams& p = map.params();
+std::vector<OccupiedCell> occupied_cells(const mapping::LayeredMap& map) {
+  const mapping::LayeredMapParams& p = map.params();
   const int side = p.block_side();
   const common::MapGrid grid = p.grid();
   const auto channels = static_cast<std::size_t>(p.channels());
@@ -34,7 +34,7 @@ std::vector<OccupiedCell> occupied_cells(const LayeredMap& map) {
   for (const common::BlockIndex& key : map.block_keys()) {
     map.fused_block(key, fused);
     for (int c = 0; c < side * side * side; ++c) {
-      const CellSummary s = summarize(
+      const mapping::CellSummary s = mapping::summarize(
           p,
           std::span<const float>(fused.data() + static_cast<std::size_t>(c) * channels, channels));
       if (!s.known || !s.occupied) continue;
@@ -50,7 +50,7 @@ std::vector<OccupiedCell> occupied_cells(const LayeredMap& map) {
 }
 
 void write_ply(const std::filesystem::path& path, const std::vector<OccupiedCell>& cells,
-               const ClassPalette& palette) {
+               const mapping::ClassPalette& palette) {
   std::vector<std::uint8_t> out;
   append_text(out,
               "ply\nformat binary_little_endian 1.0\ncomment semap occupied cells\n"
@@ -67,11 +67,11 @@ void write_ply(const std::filesystem::path& path, const std::vector<OccupiedCell
     append(out, c.probability);
     append(out, c.variance);
   }
-  write_file_atomically(path, out);
+  mapping::write_file_atomically(path, out);
 }
 
 void write_cells_pcd(const std::filesystem::path& path, const std::vector<OccupiedCell>& cells,
-                     const ClassPalette& palette) {
+                     const mapping::ClassPalette& palette) {
   std::vector<std::uint8_t> out;
   append_text(out,
               "# .PCD v0.7 - semap occupied cells\nVERSION 0.7\n"
@@ -81,7 +81,7 @@ void write_cells_pcd(const std::filesystem::path& path, const std::vector<Occupi
                   std::to_string(cells.size()) + "\nDATA binary\n");
   for (const OccupiedCell& c : cells) {
     for (int i = 0; i < 3; ++i) append(out, static_cast<float>(c.centre[i]));
-    const Rgb rgb = palette.color(c.label);
+    const mapping::Rgb rgb = palette.color(c.label);
     // PCL packs 0x00RRGGBB into the bytes of a float field named rgb.
     const std::uint32_t packed = (static_cast<std::uint32_t>(rgb[0]) << 16) |
                                  (static_cast<std::uint32_t>(rgb[1]) << 8) | rgb[2];
@@ -92,7 +92,7 @@ void write_cells_pcd(const std::filesystem::path& path, const std::vector<Occupi
     append(out, c.probability);
     append(out, c.variance);
   }
-  write_file_atomically(path, out);
+  mapping::write_file_atomically(path, out);
 }
 
-}  // namespace semap::mapping
+}  // namespace semap::map_io
