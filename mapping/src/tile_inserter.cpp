@@ -72,8 +72,8 @@ class PhaseClock {
 // Scratch tiles are 32 cells per side when that fits in kScratchBytes (K <= 4), else 16: big
 // enough that most supports fit in one (fewer pieces and split rows), small enough that the
 // scratch stays in L2 (K = 4: 512 KiB; K = 20: 16^3 cells, 320 KiB). A toy scan then has
-// 8..18 tiles, one often holding 40 % of the work, so tiles are processed busiest first;
-// 16-cell tiles (10..45 per scan) balance better but cost 8 % more time on one core.
+// 8..18 tiles, one often holding 40 % of the work, so tiles are processed busiest first
+// (16-cell tiles balance better but cost more on one core: bench/RESULTS.md).
 constexpr std::size_t kScratchBytes = 512 * 1024;
 constexpr std::int32_t kDirectBlockShift = 3;
 
@@ -90,8 +90,8 @@ std::int32_t tile_shift_for(const MapParams& params) {
 // Squared distances stored per point and axis: at least the widest support, a multiple of 8
 // so that axis_distances may write whole vectors. A support spans 2 ell / res cells plus the
 // rounding of its two float end points (well under one cell together inside the mappable
-// range), so it has at most floor(2 ell / res) + 2 cells. No more than that: the toy's 8
-// instead of 16 floats per axis took its two-thread batch insert from 5.50 to 5.00 ms.
+// range), so it has at most floor(2 ell / res) + 2 cells. No more than that: the plan's
+// distance rows are its largest array.
 std::size_t distances_per_axis(const MapParams& params) {
   const auto widest = static_cast<std::size_t>(2.0f * params.ell / params.resolution) + 2;
   return (widest + 7) / 8 * 8;
@@ -511,8 +511,8 @@ void TileInserter::process_tile(const TilePlan& plan, std::size_t tile,
   const float resolution = params_.resolution;
   PlaneTile& scratch = scratch_.local();
   // A piece's squared axis distances, computed here (a few vector operations per axis) rather
-  // than stored per point in the plan: the plan's distance rows were its largest array, and
-  // halving them had made the two-thread batch 9 % faster. Same operations, same bits.
+  // than stored per point in the plan, whose largest array they would be. Same operations,
+  // same bits.
   // Zeroed once so that reads past a piece's cells (ignored by PlaneTile) see defined values.
   std::array<float, 3 * kPieceStride> distances{};
   for (std::uint32_t p = plan.tile_offsets[tile]; p < plan.tile_offsets[tile + 1]; ++p) {
