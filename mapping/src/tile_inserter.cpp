@@ -129,29 +129,23 @@ constexpr std::size_t kBlocksPerTask = 16;
 // Points per parallel chunk of the per-point preparation.
 constexpr std::size_t kPointGrain = 1024;
 
-#if defined(__AVX2__)
-using RowKernel = KernelLanes;
-#else
-using RowKernel = KernelPolynomial;
-#endif
+// Cells of one point gathered before the kernel is evaluated for them 8 at a time: a LiDAR
+// support row has 4 cells, so evaluating per row would leave half of each vector unused.
+constexpr std::size_t kGatherCells = 256;
 
-// The kernel weights of one row of cells, 0 where mask (the cells inside the sphere) is clear:
-// w[x] = k(dyz2 + dx2[x]) for x < width <= 32. dx2 is readable up to width rounded up to 8.
-inline void row_weights(const float* dx2, std::int32_t width, float dyz2, std::uint32_t mask,
-                        const RowKernel& kernel, float* w) {
+// w[i] = k(d2[i]) for i < count; d2 is readable up to count rounded up to 8.
+inline void gathered_weights(const float* d2, std::size_t count, const KernelPolynomial& kernel,
+                             float* w) {
 #if defined(__AVX2__)
-  const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-  for (std::int32_t x = 0; x < width; x += 8) {
-    const __m256i bits = _mm256_set1_epi32(static_cast<std::int32_t>((mask >> x) & 0xFFu));
-    const __m256 inside =
-        _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(bits, lane_bit), lane_bit));
-    const __m256 d2 = _mm256_add_ps(_mm256_set1_ps(dyz2), _mm256_loadu_ps(dx2 + x));
-    _mm256_storeu_ps(w + x, kernel8(d2, inside, kernel));
+  const KernelLanes lanes(kernel);
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  for (std::size_t i = 0; i < count; i += 8) {
+    const __m256 inside = _mm256_castsi256_ps(
+        _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(count - i)), lane));
+    _mm256_storeu_ps(w + i, kernel8(_mm256_loadu_ps(d2 + i), inside, lanes));
   }
 #else
-  for (std::int32_t x = 0; x < width; ++x) {
-    w[x] = (mask >> x) & 1u ? kernel(dyz2 + dx2[x]) : 0.0f;
-  }
+  for (std::size_t i = 0; i < count; ++i) w[i] = kernel(d2[i]);
 #endif
 }
 
@@ -166,15 +160,28 @@ void smooth_point(Block& block, std::int32_t side, const CellBox& box,
   const auto k = static_cast<std::size_t>(training.num_classes);
   const float ell2 = kernel.ell_squared();
   const float* y = kSoft ? training.probabilities.data() + i * k : nullptr;
+  const std::size_t label = kSoft ? 0 : static_cast<std::size_t>(training.labels[i]);
   const std::int32_t width = box.hi[0] - box.lo[0] + 1;
   const float* dx2 = d2[0];
-  const std::size_t row_stride = static_cast<std::size_t>(side) * k;
-  alignas(32) std::array<float, 32 + 8> w;
-#if defined(__AVX2__)
-  const KernelLanes row_kernel(kernel);
-#else
-  const KernelPolynomial& row_kernel = kernel;
-#endif
+  float* const evidence = block.cell_evidence_mutable(0);
+  // Squared distances and evidence offsets of the gathered cells, then their weights.
+  alignas(32) std::array<float, kGatherCells + 8> cell_d2;
+  std::array<std::uint32_t, kGatherCells> cell_offset;
+  alignas(32) std::array<float, kGatherCells + 8> w;
+  std::size_t count = 0;
+  const auto add_gathered = [&] {
+    std::fill_n(cell_d2.begin() + static_cast<std::ptrdiff_t>(count), 8, 0.0f);
+    gathered_weights(cell_d2.data(), count, kernel, w.data());
+    for (std::size_t c = 0; c < count; ++c) {
+      float* alpha = evidence + cell_offset[c];
+      if constexpr (kSoft) {
+        for (std::size_t j = 0; j < k; ++j) alpha[j] += w[c] * y[j];
+      } else {
+        alpha[label] += w[c];
+      }
+    }
+    count = 0;
+  };
   for (std::int32_t z = box.lo[2]; z <= box.hi[2]; ++z) {
     const float dz2 = d2[2][z - box.lo[2]];
     // Rows whose centre line passes within ell: again one run, found without branches. At
@@ -184,35 +191,27 @@ void smooth_point(Block& block, std::int32_t side, const CellBox& box,
     const std::int32_t y_first = std::countr_zero(rows_inside);
     const std::int32_t y_last = 31 - std::countl_zero(rows_inside);
     const std::size_t first_row = static_cast<std::size_t>(z * side + box.lo[1]);
-    float* cells = block.cell_evidence_mutable(0) +
-                   (first_row * side + static_cast<std::size_t>(box.lo[0])) * k +
-                   static_cast<std::size_t>(y_first) * row_stride;
-    for (std::int32_t yy = y_first; yy <= y_last; ++yy, cells += row_stride) {
+    for (std::int32_t yy = y_first; yy <= y_last; ++yy) {
       const float dyz2 = dz2 + d2[1][yy];
       // x is inside when d2x < ell^2 - dyz2; the inside cells are one run (d2x is convex).
       const std::uint32_t mask = inside_mask(dx2, width, ell2 - dyz2);
       if (mask == 0) continue;
-      row_weights(dx2, width, dyz2, mask, row_kernel, w.data());
-      if constexpr (kSoft) {
-        const std::int32_t x_hi = 31 - std::countl_zero(mask);
-        for (std::int32_t x = std::countr_zero(mask); x <= x_hi; ++x) {
-          float* alpha = cells + static_cast<std::size_t>(x) * k;
-          for (std::size_t c = 0; c < k; ++c) alpha[c] += w[static_cast<std::size_t>(x)] * y[c];
-        }
-      } else {
-        // Every cell of the row, outside ones adding 0: the trip count is the same for all
-        // rows of a piece, so the loop exit is predicted (a run's length is not).
-        float* column = cells + training.labels[i];
-        for (std::int32_t x = 0; x < width; ++x) {
-          column[static_cast<std::size_t>(x) * k] += w[static_cast<std::size_t>(x)];
-        }
-      }
+      if (count + static_cast<std::size_t>(width) > kGatherCells) add_gathered();
       // A row of side <= 32 cells starts at a multiple of side, so it lies in one 64-bit word.
-      const std::size_t cell = (first_row + static_cast<std::size_t>(yy)) * side;
-      block.mark_observed_word(static_cast<int>(cell >> 6),
-                               std::uint64_t{mask << box.lo[0]} << (cell & 63));
+      const std::size_t row = (first_row + static_cast<std::size_t>(yy)) * side;
+      const std::size_t row_first = row + static_cast<std::size_t>(box.lo[0]);
+      for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits);
+        cell_d2[count] = dyz2 + dx2[x];
+        cell_offset[count] =
+            static_cast<std::uint32_t>((row_first + static_cast<std::size_t>(x)) * k);
+        ++count;
+      }
+      block.mark_observed_word(static_cast<int>(row >> 6),
+                               std::uint64_t{mask << box.lo[0]} << (row & 63));
     }
   }
+  add_gathered();
 }
 
 }  // namespace
