@@ -13,6 +13,10 @@ MapCheckpoint::MapCheckpoint(SemanticMap& map, const CheckpointParams& params, b
   if (params_.resume) {
     stats_.resumed_scans = log_.committed_scans();
     if (load) stats_.resumed_blocks = log_.load_all(map_);
+  } else if (log_.committed_scans() > 0) {
+    // A new map appended to an old one would bring the old blocks back on the next resume.
+    throw BlockLogError(params_.path.string() +
+                        ": holds a map already: resume it, or move the file away");
   }
   stats_.log_bytes = log_.bytes();
   writer_ = std::jthread([this](std::stop_token stop) { run(stop); });

@@ -42,9 +42,9 @@ class MapCheckpoint {
     std::uint64_t resumed_scans = 0;   // scans the resumed map had seen
   };
 
-  // Opens the log (BlockLogError when it belongs to other map parameters). With resume and
-  // `load` true, restores every block into `map`; a pager that loads blocks as the robot gets
-  // near them passes false.
+  // Opens the log (BlockLogError when it belongs to other map parameters, or, without resume,
+  // when it already holds a map). With resume and `load` true, restores every block into
+  // `map`; a pager that loads blocks as the robot gets near them passes false.
   MapCheckpoint(SemanticMap& map, const CheckpointParams& params, bool load = true);
   ~MapCheckpoint();
   MapCheckpoint(const MapCheckpoint&) = delete;
