@@ -135,7 +135,9 @@ function(semap_fuzz name)
   target_compile_options(${name} PRIVATE ${SEMAP_WARNINGS})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS})
   if(SEMAP_FUZZ)
-    target_compile_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
+    # Undefined behaviour stops the run like a crash (recovering would only log it).
+    target_compile_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined
+                           -fno-sanitize-recover=undefined)
     target_link_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
   else()
     target_sources(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/fuzz/replay_main.cpp)

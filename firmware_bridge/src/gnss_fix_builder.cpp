@@ -119,7 +119,11 @@ common::GnssFix fix_from_nav_pvt(const SemapUbxNavPvt& pvt, common::Stamp stamp)
   fix.satellites = pvt.num_sv;
   fix.mode = mode_from_nav_pvt(pvt);
   const unsigned both = SEMAP_UBX_PVT_VALID_DATE | SEMAP_UBX_PVT_VALID_TIME;
-  if ((pvt.valid & both) == both && pvt.month >= 1 && pvt.day >= 1) {
+  // A receiver's date lies between the GPS epoch and the end of its week counters; outside
+  // that the nanoseconds would overflow, so such a date is no time.
+  const bool plausible = pvt.year >= 1980 && pvt.year <= 2200 && pvt.month >= 1 && pvt.day >= 1 &&
+                         pvt.hour < 24 && pvt.min < 60 && pvt.sec <= 60;
+  if ((pvt.valid & both) == both && plausible) {
     const std::int64_t ms_of_day = ((pvt.hour * 60 + pvt.min) * 60 + pvt.sec) * 1000LL;
     const std::int64_t days = days_from_civil(pvt.year, pvt.month, pvt.day);
     // nano is the fraction of the second, -1e9..1e9: the rounded seconds may be one ahead.

@@ -163,6 +163,14 @@ TEST(GnssFixBuilder, NavPvtModeAndValidatedTime) {
   EXPECT_EQ(fix.mode, FixMode::k3D);
   ASSERT_TRUE(fix.utc_ns);
   EXPECT_EQ(*fix.utc_ns, utc_ns(2021, 6, 10, 18, 18, 56) - 1000);
+  // A corrupt but "valid" date far outside a receiver's range is no time (the nanoseconds
+  // since 1970 would overflow; found by gnss_stream_fuzz under UBSan).
+  p.year = 65535;
+  EXPECT_FALSE(fix_from_nav_pvt(p, common::Stamp(1)).utc_ns);
+  p.year = 2021;
+  p.hour = 99;
+  EXPECT_FALSE(fix_from_nav_pvt(p, common::Stamp(1)).utc_ns);
+  p.hour = 18;
   p.valid = SEMAP_UBX_PVT_VALID_DATE;  // time not valid yet
   EXPECT_FALSE(fix_from_nav_pvt(p, common::Stamp(1)).utc_ns);
   p.fix_type = 2;
