@@ -4,17 +4,12 @@
 #include <span>
 #include <unordered_set>
 
+#include "mappable.hpp"
 #include "semap/mapping/kernel.hpp"
 
 namespace semap::mapping {
 
 namespace {
-
-// Cell coordinates beyond this could overflow a block key.
-bool mappable(const Eigen::Vector3f& p, float inv_res) {
-  constexpr float kLimit = static_cast<float>(1 << 20) - 64.0f;
-  return p.allFinite() && (p.cwiseAbs() * inv_res).maxCoeff() < kLimit;
-}
 
 // Records each updated block once.
 class BlockWriter {
@@ -56,7 +51,7 @@ UpdateResult plain_update(const TrainingSet& training, const MapParams& params,
     const Eigen::Vector3f& x = training.points[i];
     const std::int32_t label = training.labels[i];
     const bool label_ok = label >= 0 ? label < params.num_classes : i < soft_rows;
-    if (!label_ok || !mappable(x, 1.0f / res)) {
+    if (!label_ok || !detail::mappable(x, 1.0f / res)) {
       ++result.rejected_points;
       continue;
     }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "fast_floor.hpp"
+#include "mappable.hpp"
 #include "plane_tile.hpp"
 #include "semap/common/map_grid.hpp"
 #include "semap/mapping/bki_update.hpp"
@@ -24,13 +25,6 @@
 #include "voxel_grouping.hpp"
 
 namespace semap::mapping::detail {
-
-// Training points and queries are dropped when their cell coordinates could overflow the
-// block keys.
-inline bool mappable(const Eigen::Vector3f& p, float inv_res) {
-  constexpr float kLimit = static_cast<float>(1 << 20) - 64.0f;
-  return p.allFinite() && (p.cwiseAbs() * inv_res).maxCoeff() < kLimit;
-}
 
 // What one insert touched, filled by TileInserter::insert.
 struct TileInsertResult {
