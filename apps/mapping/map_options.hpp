@@ -44,7 +44,7 @@ inline mapping::MapParams resolve_map_params(const CLI::App& app, const MapOptio
   }
   const auto& f = o.flags;
   auto given = [&](const char* flag) { return app.count(flag) > 0; };
-  if (given("--method")) p.method = mapping::method_from_string(o.method);
+  if (given("--method")) p.method = mapping::map_method_from_string(o.method);
   if (given("--resolution")) p.resolution = f.resolution;
   if (given("--block-depth")) p.block_depth = f.block_depth;
   if (given("--num-classes")) p.num_classes = f.num_classes;

@@ -16,7 +16,6 @@
 #include "semap/common/logging.hpp"
 #include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/map_params.hpp"
-#include "semap/mapping/semantic_layers.hpp"
 #include "semap/mapping/semantic_map.hpp"
 
 int main(int argc, char** argv) {
@@ -56,7 +55,7 @@ int main(int argc, char** argv) {
       semap::apps::run_logodds(params, clouds, logodds_run);
       return 0;
     }
-    semap::mapping::SemanticMap map(params);
+    semap::mapping::SemanticMap map(params, logodds_run.robot);
     std::vector<Eigen::Vector3f> origins;
     for (const auto& cloud : clouds) origins.push_back(cloud.origin);
     std::size_t rejected = 0;
@@ -84,8 +83,7 @@ int main(int argc, char** argv) {
       }
     }
     if (!logodds_run.save_path.empty()) {
-      semap::mapping::write_smap(logodds_run.save_path,
-                                 semap::mapping::to_layered_map(map, logodds_run.robot));
+      semap::mapping::write_smap(logodds_run.save_path, map.layers());
     }
     const auto stats = map.stats();
     std::printf("method %s\nscans %zu\nrejected_points %zu\nblocks %zu\ncells %zu\n",

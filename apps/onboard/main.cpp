@@ -28,7 +28,6 @@
 #include "semap/drivers/camera_driver.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/drivers/gnss_driver.hpp"
-#include "semap/mapping/semantic_layers.hpp"
 #include "semap/mapping/smap_io.hpp"
 #include "shared_pose_history.hpp"
 #include "sim_report.hpp"
@@ -326,13 +325,12 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   const auto est = estimation_stage.stats();
   const auto map = mapping_stage.stats();
   if (!config.map_save_path.empty()) {
-    mapping::write_smap(config.map_save_path,
-                        mapping::to_layered_map(mapping_stage.map(), config.robot_id));
+    mapping::write_smap(config.map_save_path, mapping_stage.map().layers());
     log->info("map saved to {}", config.map_save_path);
   }
   if (report) {
     const auto path = report->dir() / "map.smap";
-    mapping::write_smap(path, mapping::to_layered_map(mapping_stage.map(), config.robot_id));
+    mapping::write_smap(path, mapping_stage.map().layers());
     log->info("map saved to {}", path.string());
   }
   std::printf("\n== semap-onboard summary ==\n");

@@ -28,14 +28,14 @@ dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common
   for (int c = 0; c < block.num_cells(); ++c) {
     observed[static_cast<std::size_t>(c)] = block.observed(c) ? 1 : 0;
   }
-  return dds_idl::snapshot_of_evidence(index, params.grid(), block.num_classes(), block.evidence(),
+  return dds_idl::snapshot_of_evidence(index, params.grid(), block.channels(), block.evidence(),
                                        observed, params.prior, params.unknown_variance, version);
 }
 
 MappingStage::MappingStage(const OnboardConfig& config,
                            common::SpscRing<common::LabeledCloud>& clouds, BlockSink sink,
                            const std::filesystem::path& checkpoint_path)
-    : config_(config), clouds_(clouds), sink_(std::move(sink)), map_(config.map) {
+    : config_(config), clouds_(clouds), sink_(std::move(sink)), map_(config.map, config.robot_id) {
   if (checkpoint_path.empty() || config.map_checkpoint_s <= 0.0) return;
   if (checkpoint_path.has_parent_path()) {
     std::filesystem::create_directories(checkpoint_path.parent_path());
@@ -95,7 +95,7 @@ void MappingStage::record_map_frame(const mapping::MapFrame& frame) {
 const mapping::SemanticMap& MappingStage::map() {
   if (!pager_) return map_;
   if (!full_map_) {
-    full_map_ = std::make_unique<mapping::SemanticMap>(config_.map);
+    full_map_ = std::make_unique<mapping::SemanticMap>(config_.map, config_.robot_id);
     checkpoint_->log().load_all(*full_map_);
   }
   return *full_map_;

@@ -13,8 +13,8 @@
 #include "semap/estimation/simulator.hpp"
 #include "semap/firmware_bridge/emulator.hpp"
 #include "semap/mapping/class_palette.hpp"
+#include "semap/mapping/layered_map.hpp"
 #include "semap/mapping/map_params.hpp"
-#include "semap/mapping/semantic_layers.hpp"
 #include "sim_camera_feed.hpp"
 
 namespace semap::onboard {

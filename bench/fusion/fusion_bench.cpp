@@ -33,7 +33,7 @@ LayeredMap robot_map(int blocks, semap::mapping::SourceId id) {
   std::uniform_int_distribution<int> count(0, 5);
   const int side = static_cast<int>(std::ceil(std::sqrt(blocks)));
   for (int i = 0; i < blocks; ++i) {
-    semap::mapping::EvidenceGrid::Block b(layer.block_floats());
+    std::vector<float> b(layer.block_floats());
     for (float& v : b) v = static_cast<float>(count(rng));
     layer.put_block(semap::common::BlockIndex{i % side, i / side, 0}, std::move(b));
   }

@@ -21,8 +21,8 @@
 namespace {
 
 using semap::common::LabeledCloud;
+using semap::mapping::MapMethod;
 using semap::mapping::MapParams;
-using semap::mapping::Method;
 using semap::mapping::SemanticMap;
 using Clock = std::chrono::steady_clock;
 
@@ -50,7 +50,7 @@ std::vector<LabeledCloud> load_toy() {
 }
 
 // Parameters of the paper's toy run (dataset README).
-MapParams toy_params(Method method) {
+MapParams toy_params(MapMethod method) {
   MapParams p;
   p.method = method;
   return p;
@@ -111,7 +111,7 @@ const char* to_string(ToyPath path) {
   return path == ToyPath::kScan ? "scan" : path == ToyPath::kBatch ? "batch" : "plain";
 }
 
-ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, Method method, ToyPath path,
+ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, MapMethod method, ToyPath path,
                    int repetitions) {
   std::vector<Eigen::Vector3f> origins;
   for (const auto& c : clouds) origins.push_back(c.origin);
@@ -165,7 +165,7 @@ void toy_figures(int repetitions) {
   std::printf("%-5s %-8s %-6s %10s %10s %10s %10s %9s %8s  %s\n", "meth", "threads", "path",
               "insert_ms", "cpu_ms", "train_ms", "train_pts", "vs_ref", "B/cell", "map_fnv");
   std::vector<std::pair<std::string, semap::mapping::InsertPhases>> phases;
-  for (const Method method : {Method::kBki, Method::kCsm}) {
+  for (const MapMethod method : {MapMethod::kBki, MapMethod::kCsm}) {
     for (const int threads : {1, 2}) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
                                 static_cast<std::size_t>(threads));
@@ -203,7 +203,7 @@ void toy_figures(int repetitions) {
 void lidar_figures(int scans) {
   semap::bench::SyntheticLidar lidar;
   MapParams p;
-  p.method = Method::kBki;
+  p.method = MapMethod::kBki;
   p.resolution = 0.1f;
   p.num_classes = 20;
   p.block_depth = 4;

@@ -80,7 +80,7 @@ std::vector<NoiseResult> evaluate_label_noise(std::span<const common::LabeledClo
     for (std::size_t i = 0; i < noisy.size(); ++i) {
       flip_labels(noisy[i], fraction, 1, params.num_classes, seed + i);
     }
-    for (const mapping::Method method : {mapping::Method::kBki, mapping::Method::kCsm}) {
+    for (const mapping::MapMethod method : {mapping::MapMethod::kBki, mapping::MapMethod::kCsm}) {
       mapping::MapParams p = params;
       p.method = method;
       mapping::SemanticMap map(p);

@@ -164,7 +164,7 @@ std::vector<SoftLabelResult> evaluate_soft_labels(std::span<const common::Labele
   // Scan points are hits: classes 1..K-1 are the candidates and the scored classes.
   std::vector<int> classes(static_cast<std::size_t>(params.num_classes - 1));
   std::iota(classes.begin(), classes.end(), 1);
-  const auto miou = [&](mapping::Method method, const std::vector<common::LabeledCloud>& scans) {
+  const auto miou = [&](mapping::MapMethod method, const std::vector<common::LabeledCloud>& scans) {
     mapping::MapParams p = params;
     p.method = method;
     mapping::SemanticMap map(p);
@@ -186,10 +186,10 @@ std::vector<SoftLabelResult> evaluate_soft_labels(std::span<const common::Labele
       hard.push_back(std::move(s.hard));
     }
     row.error = points == 0 ? 0.0 : static_cast<double>(wrong) / static_cast<double>(points);
-    row.bki_hard = miou(mapping::Method::kBki, hard);
-    row.bki_soft = miou(mapping::Method::kBki, soft);
-    row.csm_hard = miou(mapping::Method::kCsm, hard);
-    row.csm_soft = miou(mapping::Method::kCsm, soft);
+    row.bki_hard = miou(mapping::MapMethod::kBki, hard);
+    row.bki_soft = miou(mapping::MapMethod::kBki, soft);
+    row.csm_hard = miou(mapping::MapMethod::kCsm, hard);
+    row.csm_soft = miou(mapping::MapMethod::kCsm, soft);
     rows.push_back(row);
   }
   return rows;

@@ -63,7 +63,7 @@ UpdateResult plain_update(const TrainingSet& training, const MapParams& params,
     } else {
       y = {training.probabilities.data() + i * k, k};
     }
-    if (params.method == Method::kCsm) {
+    if (params.method == MapMethod::kCsm) {
       writer.add(grid.cell_of(x), 1.0f, y);  // (1)
       continue;
     }

@@ -99,16 +99,16 @@ void remerge_blocks(LayeredMap& fused, SourceId source, const EvidenceGrid& laye
   for (const auto& target : targets) {
     for (const auto& key : source_blocks(target, from, to, T_to_from)) {
       if (!taken.insert(key).second) continue;
-      if (const auto* block = layer.find_block(key)) needed.put_block(key, *block);
+      if (const Block* block = layer.find_block(key)) needed.put_block(key, block->evidence());
     }
   }
   EvidenceGrid rebuilt = resample_layer(needed, from, to, T_to_from);
   EvidenceGrid& out = fused.layer(source);
   for (const auto& target : targets) {
-    if (auto block = rebuilt.take_block(target)) {
-      out.put_block(target, std::move(*block));
+    if (const Block* block = rebuilt.find_block(target)) {
+      out.put_block(target, block->evidence());
     } else {
-      out.take_block(target);
+      out.evict(target);
     }
   }
   out.set_updates(layer.updates());

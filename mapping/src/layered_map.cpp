@@ -60,9 +60,9 @@ bool LayeredMap::fused_block(const common::BlockIndex& key, std::vector<float>& 
   out.assign(cells * static_cast<std::size_t>(params_.channels()), 0.0f);
   bool any = false;
   for (const auto& [source, grid] : layers_) {
-    const auto* block = grid.find_block(key);
+    const Block* block = grid.find_block(key);
     if (block == nullptr) continue;
-    fuse_into(*block, out);
+    fuse_into(block->evidence(), out);
     any = true;
   }
   const auto channels = static_cast<std::size_t>(params_.channels());
@@ -75,7 +75,7 @@ bool LayeredMap::fused_block(const common::BlockIndex& key, std::vector<float>& 
 std::vector<common::BlockIndex> LayeredMap::block_keys() const {
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> keys;
   for (const auto& [source, grid] : layers_) {
-    for (const auto& [key, block] : grid.blocks()) keys.insert(key);
+    grid.for_each_block([&](const common::BlockIndex& key, const Block&) { keys.insert(key); });
   }
   return {keys.begin(), keys.end()};
 }

@@ -5,25 +5,6 @@
 
 namespace semap::mapping {
 
-std::string to_string(MapMethod method) {
-  switch (method) {
-    case MapMethod::kBki:
-      return "bki";
-    case MapMethod::kCsm:
-      return "csm";
-    case MapMethod::kLogOdds:
-      return "logodds";
-  }
-  return "unknown";
-}
-
-MapMethod map_method_from_string(const std::string& name) {
-  if (name == "bki") return MapMethod::kBki;
-  if (name == "csm") return MapMethod::kCsm;
-  if (name == "logodds") return MapMethod::kLogOdds;
-  throw std::invalid_argument("unknown map method '" + name + "' (bki, csm, logodds)");
-}
-
 namespace {
 
 void require(bool ok, const std::string& what) {
@@ -49,6 +30,52 @@ void validate(const LayeredMapParams& params) {
   require(probability(lo.label_confidence), "label_confidence must lie in (0, 1)");
   require(std::isfinite(lo.label_spread) && lo.label_spread > 0.0, "label_spread must be positive");
   require(std::isfinite(lo.max_range) && lo.max_range > 0.0, "max_range must be positive");
+}
+
+namespace {
+
+// Kernel and sampling settings kept under these names in LayeredMapParams::extra.
+struct ExtraField {
+  const char* name;
+  float MapParams::*field;
+};
+constexpr ExtraField kExtraFields[] = {
+    {"bki.sf2", &MapParams::sf2},
+    {"bki.ell", &MapParams::ell},
+    {"bki.free_res", &MapParams::free_res},
+    {"bki.ds_res", &MapParams::ds_res},
+    {"bki.max_range", &MapParams::max_range},
+    {"bki.unknown_variance", &MapParams::unknown_variance},
+};
+
+}  // namespace
+
+LayeredMapParams layered_params(const MapParams& params) {
+  LayeredMapParams p;
+  p.method = params.method;
+  p.resolution = params.resolution;
+  p.block_depth = params.block_depth;
+  p.num_classes = params.num_classes;
+  p.prior = params.prior;
+  for (const auto& f : kExtraFields) p.extra[f.name] = params.*f.field;
+  return p;
+}
+
+MapParams semantic_params(const LayeredMapParams& params) {
+  if (params.method == MapMethod::kLogOdds) {
+    throw std::invalid_argument("a log-odds map has no S-BKI/S-CSM parameters");
+  }
+  MapParams p;
+  p.method = params.method;
+  p.resolution = static_cast<float>(params.resolution);
+  p.block_depth = params.block_depth;
+  p.num_classes = params.num_classes;
+  p.prior = static_cast<float>(params.prior);
+  for (const auto& f : kExtraFields) {
+    const auto it = params.extra.find(f.name);
+    if (it != params.extra.end()) p.*f.field = static_cast<float>(it->second);
+  }
+  return p;
 }
 
 }  // namespace semap::mapping

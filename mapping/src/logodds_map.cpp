@@ -4,6 +4,7 @@
 #include <string>
 #include <unordered_set>
 
+#include "mappable.hpp"
 #include "semap/mapping/ray_traversal.hpp"
 
 namespace semap::mapping {
@@ -47,13 +48,19 @@ LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
                                 std::to_string(k));
   }
   EvidenceGrid& grid = map_.layer(robot_);
+  const auto inv_res = static_cast<float>(1.0 / p.resolution);
+  // Cells the block table can hold; a beam between two of them stays within them.
+  const auto storable = [&](const Eigen::Vector3d& point) {
+    return detail::mappable(point.cast<float>(), inv_res);
+  };
   const Eigen::Vector3d origin = cloud.origin.cast<double>();
   CellSet hits;
   CellSet free;
   LogOddsInsertResult result;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d point = cloud.points[i].cast<double>();
-    if (!point.allFinite() || (!cloud.has_probabilities() && cloud.labels[i] >= k)) {
+    if (!storable(point) || !storable(origin) ||
+        (!cloud.has_probabilities() && cloud.labels[i] >= k)) {
       ++result.rejected;
       continue;
     }

@@ -20,20 +20,19 @@ bool any_nonzero(std::span<const float> values) {
 
 EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& from_params,
                             const LayeredMapParams& to_params, const Eigen::Isometry3d& T_to_from) {
-  EvidenceGrid out(to_params.block_side(), to_params.channels());
-  out.set_updates(layer.updates());
   if (is_identity(T_to_from) && from_params.resolution == to_params.resolution &&
       from_params.block_side() == to_params.block_side()) {
-    for (const auto& [key, block] : layer.blocks()) out.put_block(key, block);
-    return out;
+    return layer;
   }
+  EvidenceGrid out(to_params.block_side(), to_params.channels());
+  out.set_updates(layer.updates());
   const Eigen::Isometry3d T_from_to = T_to_from.inverse();
   const int side = from_params.block_side();
   const double from_res = from_params.resolution;
   const common::MapGrid from_grid = from_params.grid();
   const common::MapGrid to_grid = to_params.grid();
   const auto channels = static_cast<std::size_t>(to_params.channels());
-  for (const auto& [key, block] : layer.blocks()) {
+  layer.for_each_block([&](const common::BlockIndex& key, const Block& block) {
     // Bounding box of the source block in the target frame; every target cell whose centre
     // maps back into this block lies inside it.
     const Eigen::Vector3d lo =
@@ -58,13 +57,13 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& f
           if (from_grid.block_of(source) != key) continue;
           const auto offset =
               static_cast<std::size_t>(from_grid.local_index(source, key)) * channels;
-          const std::span<const float> values(block.data() + offset, channels);
+          const std::span<const float> values(block.evidence().data() + offset, channels);
           if (!any_nonzero(values)) continue;
           std::copy(values.begin(), values.end(), out.cell(target).begin());
         }
       }
     }
-  }
+  });
   return out;
 }
 

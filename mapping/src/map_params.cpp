@@ -5,13 +5,24 @@
 
 namespace semap::mapping {
 
-Method method_from_string(const std::string& name) {
-  if (name == "bki") return Method::kBki;
-  if (name == "csm") return Method::kCsm;
-  throw std::invalid_argument("unknown map method '" + name + "' (expected bki or csm)");
+std::string to_string(MapMethod method) {
+  switch (method) {
+    case MapMethod::kBki:
+      return "bki";
+    case MapMethod::kCsm:
+      return "csm";
+    case MapMethod::kLogOdds:
+      return "logodds";
+  }
+  return "unknown";
 }
 
-std::string to_string(Method method) { return method == Method::kBki ? "bki" : "csm"; }
+MapMethod map_method_from_string(const std::string& name) {
+  if (name == "bki") return MapMethod::kBki;
+  if (name == "csm") return MapMethod::kCsm;
+  if (name == "logodds") return MapMethod::kLogOdds;
+  throw std::invalid_argument("unknown map method '" + name + "' (bki, csm, logodds)");
+}
 
 Engine engine_from_string(const std::string& name) {
   if (name == "tiled") return Engine::kTiled;
@@ -27,6 +38,9 @@ void MapParams::validate() const {
       throw std::invalid_argument(std::string("map parameter ") + name + " must be > 0");
     }
   };
+  if (method == MapMethod::kLogOdds) {
+    throw std::invalid_argument("map parameter method: logodds is not an S-BKI/S-CSM method");
+  }
   positive(resolution, "resolution");
   positive(sf2, "sf2");
   positive(ell, "ell");
@@ -50,7 +64,7 @@ void MapParams::validate() const {
 
 MapParams map_params_from_config(const common::ConfigSection& s, const MapParams& defaults) {
   MapParams p = defaults;
-  p.method = method_from_string(s.get_choice("method", to_string(p.method), {"bki", "csm"}));
+  p.method = map_method_from_string(s.get_choice("method", to_string(p.method), {"bki", "csm"}));
   p.resolution = static_cast<float>(s.get_in_range("resolution", p.resolution, 1e-3, 100.0));
   p.block_depth = s.get<int>("block_depth", p.block_depth);
   p.num_classes = s.get<int>("num_classes", p.num_classes);

@@ -14,21 +14,16 @@
 #include <vector>
 
 #include "semap/mapping/bki_update.hpp"
-#include "semap/mapping/voxel_hash_map.hpp"
 #include "tile_inserter.hpp"
 
 namespace semap::mapping {
 
-namespace {
-
-// Malloc bookkeeping per heap allocation, counted so bytes per cell is not flattering.
-constexpr std::size_t kAllocOverhead = 16;
-
-}  // namespace
-
-SemanticMap::SemanticMap(const MapParams& params)
-    : params_(params),
-      inserter_((params.validate(), std::make_unique<detail::TileInserter>(params))) {}
+SemanticMap::SemanticMap(const MapParams& params, SourceId robot)
+    : params_((params.validate(), params)),
+      layers_(layered_params(params)),
+      robot_(robot),
+      grid_(&layers_.layer(robot)),
+      inserter_(std::make_unique<detail::TileInserter>(params)) {}
 
 SemanticMap::~SemanticMap() = default;
 SemanticMap::SemanticMap(SemanticMap&&) noexcept = default;
@@ -138,7 +133,7 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
   result.training_points = training.size();
   result.hits = training.num_hits;
   const BlockAt block_at = [this](const common::BlockIndex& index) -> Block& {
-    return this->block_at(index);
+    return grid_->block_at(index);
   };
   if (params_.engine == Engine::kPlain) {
     const auto start = std::chrono::steady_clock::now();
@@ -156,7 +151,7 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
   }
   rejected_ += result.rejected_points;
   result.blocks_updated = result.updated_blocks.size();
-  ++scans_;
+  grid_->set_updates(grid_->updates() + 1);
   return result;
 }
 
@@ -185,90 +180,17 @@ int SemanticMap::label_at(const Eigen::Vector3f& point) const {
   return cell ? cell->label(params_.unknown_variance) : -1;
 }
 
-const Block* SemanticMap::find_block(const common::BlockIndex& index) const {
-  if (!VoxelHashMap::in_range(index)) return nullptr;
-  const std::uint32_t id = table_.find(index);
-  return id == VoxelHashMap::kNone || !resident_[id] ? nullptr : &blocks_[id];
-}
-
-Block& SemanticMap::block_at(const common::BlockIndex& index) {
-  const std::uint32_t id = table_.insert(index);
-  if (id == blocks_.size()) {
-    indices_.push_back(index);
-    blocks_.emplace_back(params_.cells_per_side(), params_.num_classes, new_storage());
-    resident_.push_back(1);
-  } else if (!resident_[id]) {
-    blocks_[id] = Block(params_.cells_per_side(), params_.num_classes, new_storage());
-    resident_[id] = 1;
-    --evicted_;
-  }
-  return blocks_[id];
-}
-
-float* SemanticMap::new_storage() {
-  const auto floats = static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
-  if (spare_storage_.empty()) return arena_.allocate(floats);
-  float* storage = spare_storage_.back();
-  spare_storage_.pop_back();
-  std::fill_n(storage, floats, 0.0f);
-  return storage;
-}
-
-bool SemanticMap::evict(const common::BlockIndex& index) {
-  if (!VoxelHashMap::in_range(index)) return false;
-  const std::uint32_t id = table_.find(index);
-  if (id == VoxelHashMap::kNone || !resident_[id]) return false;
-  spare_storage_.push_back(blocks_[id].cell_evidence_mutable(0));
-  // A block without storage: never read while it is not resident.
-  blocks_[id] = Block(params_.cells_per_side(), params_.num_classes, nullptr);
-  resident_[id] = 0;
-  ++evicted_;
-  return true;
-}
-
-void SemanticMap::restore_block(const common::BlockIndex& index, std::span<const float> evidence,
-                                std::span<const std::uint64_t> observed) {
-  check_block_evidence(index, evidence);
-  block_at(index).restore(evidence, observed);
-}
-
-void SemanticMap::check_block_evidence(const common::BlockIndex& index,
-                                       std::span<const float> evidence) const {
-  if (!VoxelHashMap::in_range(index)) {
-    throw std::invalid_argument("block index beyond the map's +-2^20 range");
-  }
-  const std::size_t expected =
-      static_cast<std::size_t>(params_.cells_per_block()) * params_.num_classes;
-  if (evidence.size() != expected) {
-    throw std::invalid_argument("block evidence has " + std::to_string(evidence.size()) +
-                                " floats, expected " + std::to_string(expected));
-  }
-}
-
-void SemanticMap::add_evidence(const common::BlockIndex& index, std::span<const float> evidence) {
-  check_block_evidence(index, evidence);
-  block_at(index).add_evidence(evidence);
-}
-
 MapStats SemanticMap::stats() const {
   MapStats s;
-  s.blocks = blocks_.size() - evicted_;
-  s.evicted_blocks = evicted_;
-  s.scans = scans_;
+  s.blocks = grid_->size();
+  s.evicted_blocks = grid_->evicted();
+  s.scans = scans();
   s.rejected_points = rejected_;
-  // Table, index list and the deque's slots, then every block with its two heap arrays.
-  s.bytes = table_.bytes() + indices_.capacity() * sizeof(common::BlockIndex) +
-            blocks_.size() * sizeof(Block);
-  std::size_t evidence_bytes = 0;
+  s.bytes = grid_->bytes();
   for_each_block([&](const common::BlockIndex&, const Block& block) {
     s.cells += static_cast<std::size_t>(block.num_cells());
     s.observed_cells += static_cast<std::size_t>(block.num_observed());
-    // The observed bits are one heap allocation; the evidence lives in the arena.
-    s.bytes += block.bytes() - sizeof(Block) + kAllocOverhead;
-    evidence_bytes += block.evidence().size_bytes();
   });
-  // The arena's alignment padding, and the storage of evicted blocks kept for reuse.
-  s.bytes += arena_.bytes_used() - evidence_bytes;
   return s;
 }
 

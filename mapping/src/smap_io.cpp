@@ -192,9 +192,7 @@ Header decode_header(Reader& r) {
 }
 
 std::vector<common::BlockIndex> sorted_keys(const EvidenceGrid& grid) {
-  std::vector<common::BlockIndex> keys;
-  keys.reserve(grid.size());
-  for (const auto& [key, block] : grid.blocks()) keys.push_back(key);
+  std::vector<common::BlockIndex> keys = grid.keys();
   std::sort(keys.begin(), keys.end(), [](const common::BlockIndex& a, const common::BlockIndex& b) {
     return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
   });
@@ -215,7 +213,7 @@ std::vector<std::uint8_t> encode_smap(const LayeredMap& map) {
     w.put(static_cast<std::uint32_t>(grid.size()));
     w.put_crc_since(start);
     for (const common::BlockIndex& key : sorted_keys(grid)) {
-      const auto& block = *grid.find_block(key);
+      const auto block = grid.find_block(key)->evidence();
       const std::size_t block_start = w.size();
       w.put(kBlockTag);
       w.put(key.x);
@@ -276,7 +274,10 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
         }
         const auto raw = r.take(block_floats * sizeof(float), "block values");
         r.check_crc_since(block_start, block_where);
-        EvidenceGrid::Block values(block_floats);
+        if (!EvidenceGrid::in_range(key)) {
+          r.fail_at(block_start, block_where + ": block key beyond the map's +-2^20 range");
+        }
+        std::vector<float> values(block_floats);
         std::memcpy(values.data(), raw.data(), raw.size());
         if (!std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); })) {
           r.fail_at(block_start, block_where + ": non-finite evidence");
@@ -284,7 +285,7 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
         if (grid.find_block(key) != nullptr) {
           r.fail_at(block_start, block_where + ": duplicate block key");
         }
-        grid.put_block(key, std::move(values));
+        grid.put_block(key, values);
         ++result.blocks;
       }
     }

@@ -33,7 +33,7 @@ struct SupportRule {
 };
 
 SupportRule support_rule(const MapParams& params) {
-  return {params.method == Method::kCsm, params.ell, 1.0f / params.resolution};
+  return {params.method == MapMethod::kCsm, params.ell, 1.0f / params.resolution};
 }
 
 CellBox support_of(const Eigen::Vector3f& p, const SupportRule& rule) {
@@ -82,7 +82,7 @@ std::int32_t tile_shift_for(const MapParams& params) {
   // Blocks of 8+ cells per side are tiles themselves: a support rarely spans many of them,
   // and the scratch's write-back (n K floats per touched block row) would cost more than
   // it saves at large K. S-CSM touches one cell per point: nothing to gain from a scratch.
-  if (block_shift >= kDirectBlockShift || params.method == Method::kCsm) return block_shift;
+  if (block_shift >= kDirectBlockShift || params.method == MapMethod::kCsm) return block_shift;
   const std::size_t big = std::size_t{32 * 32 * 32} * sizeof(float) * params.num_classes;
   return big <= kScratchBytes ? 5 : 4;
 }
@@ -228,7 +228,7 @@ TileInserter::TileInserter(const MapParams& params)
                   64),
       // Only blocks written in place read their axis distances from the plan; scratch tiles
       // compute each piece's (see process_tile).
-      width_(params.method == Method::kCsm || tile_shift_ != block_shift_
+      width_(params.method == MapMethod::kCsm || tile_shift_ != block_shift_
                  ? 0
                  : distances_per_axis(params)),
       scratch_(std::int32_t{1} << tile_shift_, params.num_classes) {}
@@ -456,7 +456,7 @@ void TileInserter::scatter_in_place(const TilePlan& plan, Block& block,
                                     const TrainingSet& training) const {
   const std::int32_t side = 1 << tile_shift_;
   const auto k = static_cast<std::size_t>(params_.num_classes);
-  if (params_.method == Method::kCsm) {
+  if (params_.method == MapMethod::kCsm) {
     // The support is the point's cell, inside this block.
     const CellBox& cell_box = plan.boxes[i];
     const int cell =

@@ -37,7 +37,9 @@ LayeredMap TilePager::full_map() const {
     const SmapReadResult tile = read_smap(store_.tile_path(key));
     for (const auto& [source, layer] : tile.map.layers()) {
       EvidenceGrid& target = full.layer(source);
-      for (const auto& [tile_key, block] : layer.blocks()) target.put_block(tile_key, block);
+      layer.for_each_block([&](const common::BlockIndex& tile_key, const Block& block) {
+        target.put_block(tile_key, block.evidence());
+      });
     }
   }
   return full;

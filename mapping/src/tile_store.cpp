@@ -31,11 +31,11 @@ std::size_t TileStore::evict(LayeredMap& map, const common::BlockIndex& key) {
   LayeredMap tile(map.params());
   std::size_t moved = 0;
   for (const auto& [source, layer] : map.layers()) {
-    const auto* block = layer.find_block(key);
+    const Block* block = layer.find_block(key);
     if (block == nullptr) continue;
     EvidenceGrid& out = tile.layer(source);
     out.set_updates(layer.updates());
-    out.put_block(key, *block);
+    out.restore_block(key, block->evidence(), block->observed_words());
     ++moved;
   }
   if (moved == 0) return 0;
@@ -43,7 +43,7 @@ std::size_t TileStore::evict(LayeredMap& map, const common::BlockIndex& key) {
   write_smap(tile_path(key), tile, durable_);
   keys_.insert(key);
   // Drop from memory only once the tile is durable.
-  for (const auto& [source, layer] : tile.layers()) map.layer(source).take_block(key);
+  for (const auto& [source, layer] : tile.layers()) map.layer(source).evict(key);
   return moved;
 }
 
@@ -57,17 +57,11 @@ bool TileStore::restore(LayeredMap& map, const common::BlockIndex& key) {
   for (const auto& [source, layer] : tile.map.layers()) {
     EvidenceGrid& target = map.layer(source);
     target.set_updates(std::max(target.updates(), layer.updates()));
-    for (const auto& [tile_key, block] : layer.blocks()) {
+    for (const common::BlockIndex& tile_key : layer.keys()) {
       if (tile_key != key) throw SmapError(path.string() + ": holds a block of another tile");
-      const auto* existing = target.find_block(key);
-      if (existing == nullptr) {
-        target.put_block(key, block);
-        continue;
-      }
-      EvidenceGrid::Block sum = *existing;
-      for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += block[i];
-      target.put_block(key, std::move(sum));
     }
+    // Adds to any evidence the block gathered in memory since it went out.
+    if (const Block* block = layer.find_block(key)) target.add_block(key, block->evidence());
   }
   std::filesystem::remove(path);
   keys_.erase(key);

@@ -45,7 +45,7 @@ TEST_F(DdsTest, RobotAndClientAgreeOnTheCellOfPointsAtBlockFaces) {
   std::size_t checked = 0;
   for (const float resolution : {0.1f, 0.2f, 0.25f, 0.3f}) {
     mapping::MapParams params;
-    params.method = mapping::Method::kCsm;  // a point's evidence stays in its own cell
+    params.method = mapping::MapMethod::kCsm;  // a point's evidence stays in its own cell
     params.resolution = resolution;
     params.block_depth = 3;
     params.num_classes = kClasses;

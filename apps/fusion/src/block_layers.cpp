@@ -27,8 +27,8 @@ mapping::LayeredMapParams layered_params(const dds_idl::MapDescription& descript
   return p;
 }
 
-mapping::EvidenceGrid::Block evidence_block(const dds_idl::BlockSnapshot& block,
-                                            const mapping::LayeredMapParams& params) {
+std::vector<float> evidence_block(const dds_idl::BlockSnapshot& block,
+                                  const mapping::LayeredMapParams& params) {
   if (block.block_cells != params.block_side() || block.num_classes != params.num_classes ||
       block.evidence.size() != block.cell_count() * block.num_classes) {
     throw std::invalid_argument(

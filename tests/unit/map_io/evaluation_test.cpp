@@ -61,7 +61,7 @@ TEST(Evaluation, BkiFillsTheGapBetweenSparseHitsThatCsmLeavesUnknown) {
   MapParams p;
   p.num_classes = 3;
   SemanticMap bki(p);
-  p.method = Method::kCsm;
+  p.method = MapMethod::kCsm;
   SemanticMap csm(p);
   bki.insert(t);
   csm.insert(t);
@@ -76,8 +76,8 @@ TEST(Evaluation, BkiBeatsCsmOnTheToyDatasetAtEveryNoiseLevel) {
   const auto rows = evaluate_label_noise(scans, MapParams{}, noise, 1);
   ASSERT_EQ(rows.size(), 6u);
   for (std::size_t i = 0; i < rows.size(); i += 2) {
-    ASSERT_EQ(rows[i].method, Method::kBki);
-    ASSERT_EQ(rows[i + 1].method, Method::kCsm);
+    ASSERT_EQ(rows[i].method, MapMethod::kBki);
+    ASSERT_EQ(rows[i + 1].method, MapMethod::kCsm);
     EXPECT_GT(rows[i].mean_iou, rows[i + 1].mean_iou) << "noise " << rows[i].noise;
   }
   // More noise, worse maps.

@@ -23,7 +23,7 @@ std::vector<Eigen::Vector3f> origins_of(const std::vector<common::LabeledCloud>&
   return origins;
 }
 
-MapParams params_for(Method method) {
+MapParams params_for(MapMethod method) {
   MapParams p;
   p.method = method;
   return p;
@@ -47,7 +47,7 @@ void expect_identical(const SemanticMap& a, const SemanticMap& b) {
   EXPECT_EQ(compared, a.stats().blocks);
 }
 
-class BatchInsert : public ::testing::TestWithParam<Method> {};
+class BatchInsert : public ::testing::TestWithParam<MapMethod> {};
 
 TEST_P(BatchInsert, EqualsOneByOneInsertionOnOneAndTwoThreads) {
   const auto scans = toy_scans(5);
@@ -78,23 +78,23 @@ TEST_P(BatchInsert, EqualsOneByOneInsertionOnOneAndTwoThreads) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, BatchInsert, ::testing::Values(Method::kBki, Method::kCsm));
+INSTANTIATE_TEST_SUITE_P(Methods, BatchInsert, ::testing::Values(MapMethod::kBki, MapMethod::kCsm));
 
 TEST(BatchInsert, ABadScanLeavesTheScansBeforeItInsertedAndThrows) {
   auto scans = toy_scans(4);
   scans[2].labels.pop_back();  // one label short: build_training_set throws
   const auto origins = origins_of(scans);
-  SemanticMap first_two(params_for(Method::kBki));
+  SemanticMap first_two(params_for(MapMethod::kBki));
   first_two.insert(scans[0], scans[0].origin);
   first_two.insert(scans[1], scans[1].origin);
-  SemanticMap batch(params_for(Method::kBki));
+  SemanticMap batch(params_for(MapMethod::kBki));
   tbb::task_arena(2).execute(
       [&] { EXPECT_THROW(batch.insert(scans, origins), std::invalid_argument); });
   expect_identical(first_two, batch);
 }
 
 TEST(BatchInsert, AnEmptyBatchLeavesTheMapEmpty) {
-  SemanticMap map(params_for(Method::kBki));
+  SemanticMap map(params_for(MapMethod::kBki));
   EXPECT_TRUE(
       map.insert(std::span<const common::LabeledCloud>{}, std::span<const Eigen::Vector3f>{})
           .empty());
@@ -105,7 +105,7 @@ TEST(BatchInsert, AnEmptyBatchLeavesTheMapEmpty) {
 TEST(BatchInsert, RejectsAnOriginCountThatDiffersFromTheScans) {
   const auto scans = toy_scans(2);
   const std::vector<Eigen::Vector3f> one_origin{scans[0].origin};
-  SemanticMap map(params_for(Method::kBki));
+  SemanticMap map(params_for(MapMethod::kBki));
   EXPECT_THROW(map.insert(scans, one_origin), std::invalid_argument);
   EXPECT_EQ(map.stats().scans, 0u);
 }

@@ -150,7 +150,7 @@ TEST(PlainUpdate, EveryCellHoldsTheKernelSumOfTheEquation) {
 
 TEST(PlainUpdate, CsmAddsTheLabelToTheCellHoldingThePoint) {
   MapParams params;
-  params.method = Method::kCsm;
+  params.method = MapMethod::kCsm;
   params.num_classes = 3;
   TrainingSet t;
   t.num_classes = 3;
@@ -252,7 +252,7 @@ TEST_P(ToyTiledEqualsPlain, OnAllTwelveScans) {
   EXPECT_GT(d.cells, 10000u);
 }
 
-MapParams toy_params(int depth, Method method = Method::kBki) {
+MapParams toy_params(int depth, MapMethod method = MapMethod::kBki) {
   MapParams p;
   p.block_depth = depth;
   p.method = method;
@@ -264,7 +264,7 @@ INSTANTIATE_TEST_SUITE_P(Maps, ToyTiledEqualsPlain,
                                            ToyCase{"bki_depth4", toy_params(4)},
                                            ToyCase{"bki_depth3_soft", toy_params(3), true},
                                            ToyCase{"bki_depth5_soft", toy_params(5), true},
-                                           ToyCase{"csm_depth3", toy_params(3, Method::kCsm)}),
+                                           ToyCase{"csm_depth3", toy_params(3, MapMethod::kCsm)}),
                          [](const ::testing::TestParamInfo<ToyCase>& info) {
                            return info.param.name;
                          });

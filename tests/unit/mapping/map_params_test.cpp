@@ -13,7 +13,7 @@ TEST(MapParams, ReadsAMapSectionAndKeepsDefaultsForAbsentKeys) {
   const auto section = root.section("map");
   const MapParams p = map_params_from_config(section);
   section.finish();
-  EXPECT_EQ(p.method, Method::kCsm);
+  EXPECT_EQ(p.method, MapMethod::kCsm);
   EXPECT_FLOAT_EQ(p.resolution, 0.2f);
   EXPECT_EQ(p.block_depth, 4);
   EXPECT_EQ(p.cells_per_side(), 8);
@@ -35,7 +35,7 @@ TEST(MapParams, BadValuesNameTheKey) {
   EXPECT_NE(error_of("resolution: 0\n").find("resolution"), std::string::npos);
   EXPECT_NE(error_of("block_depth: 9\n").find("block_depth"), std::string::npos);
   EXPECT_NE(error_of("num_classes: 1\n").find("num_classes"), std::string::npos);
-  EXPECT_THROW(method_from_string("gp"), std::invalid_argument);
+  EXPECT_THROW(map_method_from_string("gp"), std::invalid_argument);
 }
 
 }  // namespace

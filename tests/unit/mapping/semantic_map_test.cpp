@@ -107,7 +107,7 @@ TEST(SemanticMap, SoftLabelAddsKernelTimesProbabilityVector) {
 
 TEST(SemanticMap, CsmEqualsPerCellCounts) {
   MapParams params = bki_params(5);
-  params.method = Method::kCsm;
+  params.method = MapMethod::kCsm;
   SemanticMap map(params);
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> coord(-1.0f, 1.0f);
@@ -147,7 +147,7 @@ TEST(SemanticMap, CsmEqualsPerCellCounts) {
 
 TEST(SemanticMap, TwoClassCsmIsTheBinaryCountingSensorModel) {
   MapParams params = bki_params(2);
-  params.method = Method::kCsm;
+  params.method = MapMethod::kCsm;
   params.prior = 0.5f;
   SemanticMap map(params);
   // One cell: 7 hits (class 1) and 3 pass-throughs (class 0).
@@ -168,7 +168,7 @@ TEST(SemanticMap, TwoClassCsmIsTheBinaryCountingSensorModel) {
 
 std::vector<common::LabeledCloud> toy_scans(int count) { return testing::toy_scans(1, count); }
 
-SemanticMap build_with_threads(const std::vector<common::LabeledCloud>& scans, Method method,
+SemanticMap build_with_threads(const std::vector<common::LabeledCloud>& scans, MapMethod method,
                                int threads) {
   MapParams params = bki_params();
   params.method = method;
@@ -180,7 +180,7 @@ SemanticMap build_with_threads(const std::vector<common::LabeledCloud>& scans, M
   return map;
 }
 
-class ThreadInvariance : public ::testing::TestWithParam<Method> {};
+class ThreadInvariance : public ::testing::TestWithParam<MapMethod> {};
 
 TEST_P(ThreadInvariance, MultiThreadedEqualsSingleThreadedBitForBit) {
   const auto scans = toy_scans(3);
@@ -199,7 +199,8 @@ TEST_P(ThreadInvariance, MultiThreadedEqualsSingleThreadedBitForBit) {
   EXPECT_EQ(compared, one.stats().blocks);
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, ThreadInvariance, ::testing::Values(Method::kBki, Method::kCsm));
+INSTANTIATE_TEST_SUITE_P(Methods, ThreadInvariance,
+                         ::testing::Values(MapMethod::kBki, MapMethod::kCsm));
 
 TEST(SemanticMap, AddingBlockEvidenceMergesMaps) {
   const auto scans = toy_scans(2);

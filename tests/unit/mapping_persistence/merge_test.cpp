@@ -107,9 +107,10 @@ TEST(Merge, ResamplingMovesEvidenceWithTheTransform) {
   EXPECT_FLOAT_EQ(f[0], 2.0f);
   EXPECT_FLOAT_EQ(f[3], 5.0f);
   std::size_t cells = 0;
-  for (const auto& [key, block] : a.find_layer(2)->blocks()) {
-    for (std::size_t i = 0; i < block.size(); i += 5) cells += block[i] != 0.0f;
-  }
+  a.find_layer(2)->for_each_block([&](const common::BlockIndex&, const Block& block) {
+    const auto evidence = block.evidence();
+    for (std::size_t i = 0; i < evidence.size(); i += 5) cells += evidence[i] != 0.0f;
+  });
   EXPECT_GE(cells, 1u);
   EXPECT_LE(cells, 3u);  // nearest-neighbour resampling of one cell touches at most a few
 }

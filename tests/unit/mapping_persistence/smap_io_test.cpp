@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -102,10 +103,11 @@ TEST_F(SmapIo, SalvageLoadsBlocksBeforeTheDamage) {
   EXPECT_LT(salvaged.blocks, map.resident_blocks());
   // Every salvaged block is exactly the written one.
   for (const auto& [source, grid] : salvaged.map.layers()) {
-    for (const auto& [key, block] : grid.blocks()) {
-      ASSERT_NE(map.find_layer(source)->find_block(key), nullptr);
-      EXPECT_EQ(*map.find_layer(source)->find_block(key), block);
-    }
+    grid.for_each_block([&](const common::BlockIndex& key, const Block& block) {
+      const Block* written = map.find_layer(source)->find_block(key);
+      ASSERT_NE(written, nullptr);
+      EXPECT_TRUE(std::ranges::equal(written->evidence(), block.evidence()));
+    });
   }
   // A damaged header is never salvaged.
   auto bad_header = bytes;

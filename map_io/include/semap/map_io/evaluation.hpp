@@ -42,7 +42,7 @@ ConfusionMatrix score_map(const mapping::SemanticMap& map,
 // at the scan points against the clean labels over the occupied classes 1..K-1.
 struct NoiseResult {
   double noise = 0.0;
-  mapping::Method method = mapping::Method::kBki;
+  mapping::MapMethod method = mapping::MapMethod::kBki;
   ConfusionMatrix confusion{1};
   double mean_iou = 0.0;
 };

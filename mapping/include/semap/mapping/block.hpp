@@ -2,36 +2,40 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <memory>
 #include <span>
 
 namespace semap::mapping {
 
-// A dense cube of cells_per_side^3 cells. Per cell it stores K floats of Dirichlet evidence
-// (alpha minus the prior, so blocks from different maps can simply be added) and one bit
-// that says whether the cell was ever observed: covered by a training point's support (S-BKI:
-// centre strictly within ell; S-CSM: the point lies in the cell) or given positive evidence. Cell c
-// = (z * n + y) * n + x holds evidence()[c * K .. c * K + K).
+// A dense cube of cells_per_side^3 cells, the unit every map stores, pages, saves and sends.
+// Per cell it holds `channels` floats of evidence, whose meaning is the cell model's (S-BKI /
+// S-CSM: K Dirichlet increments alpha - alpha_0, so blocks from different maps can simply be
+// added; log-odds: occupancy then K label log-odds), and one bit that says whether the cell was
+// ever observed. Cell c = (z * n + y) * n + x holds evidence()[c * channels .. + channels).
+//
+// The evidence lives in storage owned by the EvidenceGrid (its BlockArena); a block only
+// borrows it.
 class Block {
  public:
-  Block(int cells_per_side, int num_classes);
-  // Evidence in `storage` (cells * K zeroed floats), owned by the caller and outliving the
-  // block (SemanticMap's BlockArena).
-  Block(int cells_per_side, int num_classes, float* storage);
+  // `storage`: cells * channels zeroed floats, or nullptr for a block paged out of memory
+  // (never read).
+  Block(int cells_per_side, int channels, float* storage);
 
   int cells_per_side() const { return n_; }
   int num_cells() const { return n_ * n_ * n_; }
-  int num_classes() const { return k_; }
+  int channels() const { return channels_; }
   int cell_of(int x, int y, int z) const { return (z * n_ + y) * n_ + x; }
 
-  std::span<const float> evidence() const;
-  std::span<const float> cell_evidence(int cell) const {
-    return {evidence_.get() + static_cast<std::size_t>(cell) * k_, static_cast<std::size_t>(k_)};
+  std::span<const float> evidence() const {
+    return {storage_, static_cast<std::size_t>(num_cells()) * channels_};
   }
-  // Raw write access for the map's scatter loop; callers mark the cells they touch.
+  std::span<const float> cell_evidence(int cell) const {
+    return {storage_ + static_cast<std::size_t>(cell) * channels_,
+            static_cast<std::size_t>(channels_)};
+  }
+  // Raw write access for the update loops; callers mark the cells they touch.
   float* cell_evidence_mutable(int cell) {
-    return evidence_.get() + static_cast<std::size_t>(cell) * k_;
+    return storage_ + static_cast<std::size_t>(cell) * channels_;
   }
 
   bool observed(int cell) const { return (observed_[cell >> 6] >> (cell & 63)) & 1u; }
@@ -42,30 +46,24 @@ class Block {
   // The observed bits, cell c at bit c % 64 of word c / 64.
   std::span<const std::uint64_t> observed_words() const;
 
-  // Adds evidence (num_cells * K floats) and sets the observed bits of `observed` (as
+  // Adds evidence (num_cells * channels floats) and sets the observed bits of `observed` (as
   // observed_words()): how a block written out by a checkpoint or a pager comes back exactly.
   void restore(std::span<const float> evidence, std::span<const std::uint64_t> observed);
-
-  // Adds evidence for every cell (num_cells * K floats); cells whose added evidence sums to
-  // more than zero become observed. This is how maps are merged.
+  // Adds evidence for every cell; cells given any non-zero value become observed. This is how
+  // maps are merged and files are read.
   void add_evidence(std::span<const float> evidence);
+  // Zero evidence, nothing observed.
+  void clear();
 
   // Bytes of this block (evidence, observed bits and the object itself).
   std::size_t bytes() const;
 
  private:
-  // calloc'd: fresh pages arrive zeroed from the kernel, so a new block costs no memset and
-  // its first touch happens in the (parallel) update rather than at creation.
-  struct FreeDeleter {
-    bool owned = true;
-    void operator()(float* p) const {
-      if (owned) std::free(p);
-    }
-  };
+  void check_size(std::span<const float> evidence) const;
 
   int n_;
-  int k_;
-  std::unique_ptr<float[], FreeDeleter> evidence_;
+  int channels_;
+  float* storage_;
   std::unique_ptr<std::uint64_t[]> observed_;
 };
 

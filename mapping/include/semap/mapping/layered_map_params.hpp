@@ -5,15 +5,9 @@
 #include <string>
 
 #include "semap/common/map_grid.hpp"
+#include "semap/mapping/map_params.hpp"
 
 namespace semap::mapping {
-
-// How the evidence of a map is interpreted. The numeric values are stored in .smap files.
-enum class MapMethod : std::uint8_t { kBki = 0, kCsm = 1, kLogOdds = 2 };
-
-std::string to_string(MapMethod method);
-// Parses "bki", "csm" or "logodds"; throws std::invalid_argument otherwise.
-MapMethod map_method_from_string(const std::string& name);
 
 // Occupancy and label model of the log-odds map (Yue et al.), OctoMap's occupancy defaults.
 struct LogOddsParams {
@@ -57,5 +51,11 @@ struct LayeredMapParams {
 
 // Throws std::invalid_argument naming the first parameter that is out of range.
 void validate(const LayeredMapParams& params);
+
+// S-BKI/S-CSM parameters as stored with a map; kernel and sampling settings go to `extra`
+// under "bki.*" so a map file remembers how it was built.
+LayeredMapParams layered_params(const MapParams& params);
+// The inverse; throws std::invalid_argument for a log-odds map.
+MapParams semantic_params(const LayeredMapParams& params);
 
 }  // namespace semap::mapping

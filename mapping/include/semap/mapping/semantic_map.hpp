@@ -2,21 +2,21 @@
 
 #include <Eigen/Core>
 #include <cstddef>
-#include <deque>
 #include <memory>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "semap/common/cell_posterior.hpp"
 #include "semap/common/map_grid.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/mapping/block.hpp"
-#include "semap/mapping/block_arena.hpp"
+#include "semap/mapping/evidence_grid.hpp"
 #include "semap/mapping/kernel.hpp"
+#include "semap/mapping/layered_map.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/training_data.hpp"
-#include "semap/mapping/voxel_hash_map.hpp"
 
 namespace semap::mapping {
 
@@ -56,20 +56,31 @@ struct InsertResult {
   InsertPhases phases;
 };
 
-// The continuous semantic map of Gan et al. (S-CSM / S-BKI): a hash map of blocks of cells,
-// each cell a Dirichlet posterior over K classes updated in place by every scan.
+// The continuous semantic map of Gan et al. (S-CSM / S-BKI): blocks of cells, each cell a
+// Dirichlet posterior over K classes (common::CellPosterior) updated in place by every scan.
+//
+// The blocks are the robot's own evidence layer of a LayeredMap: saving, merging, checkpoints,
+// paging, export and the DDS publisher read that layer where it is, without a copy. Reads here
+// (query, for_each_block, stats) see the robot's own evidence; layers merged in from other
+// robots are read fused through layers().
 //
 // Insertion runs in parallel over blocks with TBB (use a tbb::task_arena or
 // tbb::global_control to bound threads). Every block is written by one task that visits its
 // training points in a fixed order, so the result does not depend on the thread count.
 class SemanticMap {
  public:
-  explicit SemanticMap(const MapParams& params);
+  // A map whose own scans go to the layer of `robot`.
+  explicit SemanticMap(const MapParams& params, SourceId robot = 0);
   ~SemanticMap();
   SemanticMap(SemanticMap&&) noexcept;
   SemanticMap& operator=(SemanticMap&&) noexcept;
 
   const MapParams& params() const { return params_; }
+  // The map as stored: this robot's layer and any merged in (what .smap files and merging use).
+  const LayeredMap& layers() const { return layers_; }
+  SourceId robot() const { return robot_; }
+  // This robot's evidence.
+  const EvidenceGrid& grid() const { return *grid_; }
 
   // Builds the scan's training set (see build_training_set) and fuses it.
   InsertResult insert(const common::LabeledCloud& cloud, const Eigen::Vector3f& origin);
@@ -92,13 +103,10 @@ class SemanticMap {
   // Class at `point`: the argmax, or -1 where the map is unknown.
   int label_at(const Eigen::Vector3f& point) const;
 
-  // Calls f(const common::BlockIndex&, const Block&) for every block in memory, in no particular
-  // order.
+  // Calls f(const common::BlockIndex&, const Block&) for every block in memory.
   template <typename F>
   void for_each_block(F&& f) const {
-    for (std::size_t b = 0; b < blocks_.size(); ++b) {
-      if (resident_[b]) f(indices_[b], blocks_[b]);
-    }
+    grid_->for_each_block(std::forward<F>(f));
   }
   // Calls f(const Eigen::Vector3f& centre, const common::CellPosterior&) for every observed cell.
   template <typename F>
@@ -113,48 +121,42 @@ class SemanticMap {
   }
 
   // The block at `index` if it is in memory.
-  const Block* find_block(const common::BlockIndex& index) const;
+  const Block* find_block(const common::BlockIndex& index) const {
+    return grid_->find_block(index);
+  }
   // Adds evidence (cells per block * K floats) to a block, creating it if needed (merging).
   // Throws std::invalid_argument for a block index beyond +-2^20 or a wrong float count.
-  void add_evidence(const common::BlockIndex& index, std::span<const float> evidence);
+  void add_evidence(const common::BlockIndex& index, std::span<const float> evidence) {
+    grid_->add_block(index, evidence);
+  }
   // Adds a block's evidence and observed bits as Block::restore does, creating it if needed:
   // a block coming back from a checkpoint or a pager. Throws as add_evidence.
   void restore_block(const common::BlockIndex& index, std::span<const float> evidence,
-                     std::span<const std::uint64_t> observed);
-  // Drops the block at `index` from memory (a pager has written it out); its storage is reused
-  // by the next block created. Returns false when it is not in memory. An insert that reaches
-  // an evicted block starts it again from zero evidence: restore it first.
-  bool evict(const common::BlockIndex& index);
+                     std::span<const std::uint64_t> observed) {
+    grid_->restore_block(index, evidence, observed);
+  }
+  // Drops the block at `index` from memory (a pager has written it out). Returns false when it
+  // is not in memory. An insert that reaches an evicted block starts it again from zero
+  // evidence: restore it first.
+  bool evict(const common::BlockIndex& index) { return grid_->evict(index); }
 
   common::BlockIndex block_of(const Eigen::Vector3f& point) const;
   Eigen::Vector3f cell_center(const common::BlockIndex& block, int cell) const;
 
   MapStats stats() const;
-  // Inserts so far (cheap, unlike stats()).
-  std::size_t scans() const { return scans_; }
+  // Inserts so far (cheap, unlike stats()): the update count of the robot's layer.
+  std::size_t scans() const { return static_cast<std::size_t>(grid_->updates()); }
 
  private:
-  Block& block_at(const common::BlockIndex& index);
-  // Zeroed evidence storage for one block: an evicted block's, or fresh from the arena.
-  float* new_storage();
-  void check_block_evidence(const common::BlockIndex& index, std::span<const float> evidence) const;
   // insert(training), with the map-independent part already done when `plan` is given.
   InsertResult fuse(const TrainingSet& training, detail::TilePlan* plan);
   // fuse() plus the training set's own rejected and out-of-range counts (scans given as clouds).
   InsertResult fuse_scan(const TrainingSet& training, detail::TilePlan* plan);
 
   MapParams params_;
-  // The block table: an open-addressing map from block index to the block's position in
-  // blocks_ (a deque, so Block references stay valid while blocks are added).
-  VoxelHashMap table_;
-  std::vector<common::BlockIndex> indices_;
-  // Before blocks_: the blocks' evidence lives in it, so it must be destroyed after them.
-  BlockArena arena_;
-  std::deque<Block> blocks_;
-  std::vector<std::uint8_t> resident_;  // per entry of blocks_: 0 once evicted
-  std::vector<float*> spare_storage_;   // evidence storage of evicted blocks, for reuse
-  std::size_t evicted_ = 0;
-  std::size_t scans_ = 0;
+  LayeredMap layers_;
+  SourceId robot_;
+  EvidenceGrid* grid_;  // the layer of robot_ in layers_ (std::map nodes do not move)
   std::size_t rejected_ = 0;
   // Insertion engine with its per-scan buffers and per-thread scratch, reused across scans.
   std::unique_ptr<detail::TileInserter> inserter_;

@@ -22,8 +22,8 @@ mapping::LayeredMapParams layered_params(const dds_idl::MapDescription& descript
 
 // The block's evidence as a layer block; the block must carry evidence of `params`' shape
 // (throws std::invalid_argument otherwise).
-mapping::EvidenceGrid::Block evidence_block(const dds_idl::BlockSnapshot& block,
-                                            const mapping::LayeredMapParams& params);
+std::vector<float> evidence_block(const dds_idl::BlockSnapshot& block,
+                                  const mapping::LayeredMapParams& params);
 
 // The fused block `key` of `map` as a DDS block: evidence alpha - alpha_0 summed over the
 // layers, state, argmax class and its variance as common::CellPosterior reads them
