@@ -62,9 +62,16 @@ void Block::add_evidence(std::span<const float> evidence) {
   }
 }
 
-void Block::clear() {
-  std::fill(storage_, storage_ + evidence().size(), 0.0f);
+void Block::assign(std::span<const float> evidence) {
+  check_size(evidence);
+  std::copy(evidence.begin(), evidence.end(), storage_);
   std::fill_n(observed_.get(), words_for(num_cells()), std::uint64_t{0});
+  for (int c = 0; c < num_cells(); ++c) {
+    const auto cell = cell_evidence(c);
+    if (std::any_of(cell.begin(), cell.end(), [](float v) { return v != 0.0f; })) {
+      mark_observed(c);
+    }
+  }
 }
 
 std::size_t Block::bytes() const {

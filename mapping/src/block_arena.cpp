@@ -3,6 +3,8 @@
 #include <sys/mman.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <new>
 #include <utility>
 
@@ -10,9 +12,13 @@ namespace semap::mapping {
 
 namespace {
 
-// 32 MiB per mapping: 16 huge pages, a few hundred LiDAR blocks or thousands of small ones.
-// Untouched pages of a mapping cost address space only.
-constexpr std::size_t kChunkBytes = std::size_t{32} << 20;
+// Chunks double from 16 KiB to 32 MiB (16 huge pages, a few hundred LiDAR blocks). The small
+// ones come from calloc, whose freed memory the next map reuses without page faults (a tile, a
+// file read); the large ones are anonymous mappings with huge pages. Untouched pages of a
+// mapping cost address space only.
+constexpr std::size_t kFirstChunkBytes = std::size_t{16} << 10;
+constexpr std::size_t kMaxChunkBytes = std::size_t{32} << 20;
+constexpr std::size_t kMappedChunkBytes = std::size_t{4} << 20;
 constexpr std::size_t kAlignment = 64;
 
 }  // namespace
@@ -38,23 +44,42 @@ BlockArena& BlockArena::operator=(BlockArena&& other) noexcept {
 }
 
 void BlockArena::release() {
-  for (const Chunk& c : chunks_) munmap(c.base, c.size);
+  for (const Chunk& c : chunks_) {
+    if (c.allocation != nullptr) {
+      std::free(c.allocation);
+    } else {
+      munmap(c.base, c.size);
+    }
+  }
   chunks_.clear();
 }
 
-float* BlockArena::allocate(std::size_t floats) {
-  const std::size_t bytes = (floats * sizeof(float) + kAlignment - 1) / kAlignment * kAlignment;
-  if (chunks_.empty() || used_ + bytes > chunks_.back().size) {
-    const std::size_t size = std::max(kChunkBytes, bytes);
+void BlockArena::reserve(std::size_t bytes) {
+  if (!chunks_.empty() && used_ + bytes <= chunks_.back().size) return;
+  const std::size_t next =
+      chunks_.empty() ? kFirstChunkBytes : std::min(2 * chunks_.back().size, kMaxChunkBytes);
+  const std::size_t size = std::max(next, bytes);
+  if (size < kMappedChunkBytes) {
+    void* allocation = std::calloc(size + kAlignment, 1);
+    if (allocation == nullptr) throw std::bad_alloc();
+    const auto address = reinterpret_cast<std::uintptr_t>(allocation);
+    void* base = reinterpret_cast<void*>((address + kAlignment - 1) / kAlignment * kAlignment);
+    chunks_.push_back({base, size, allocation});
+  } else {
     void* base = mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (base == MAP_FAILED) throw std::bad_alloc();
 #ifdef MADV_HUGEPAGE
     // Advice only: without huge pages the mapping still works with 4 KiB pages.
     madvise(base, size, MADV_HUGEPAGE);
 #endif
-    chunks_.push_back({base, size});
-    used_ = 0;
+    chunks_.push_back({base, size, nullptr});
   }
+  used_ = 0;
+}
+
+float* BlockArena::allocate(std::size_t floats) {
+  const std::size_t bytes = (floats * sizeof(float) + kAlignment - 1) / kAlignment * kAlignment;
+  reserve(bytes);
   auto* out = reinterpret_cast<float*>(static_cast<char*>(chunks_.back().base) + used_);
   used_ += bytes;
   used_total_ += bytes;

@@ -11,11 +11,13 @@ namespace {
 // Malloc bookkeeping per heap allocation, counted so bytes per cell is not flattering.
 constexpr std::size_t kAllocOverhead = 16;
 
+[[noreturn, gnu::noinline]] void throw_out_of_range(const common::BlockIndex& key) {
+  throw std::invalid_argument("block (" + std::to_string(key.x) + ", " + std::to_string(key.y) +
+                              ", " + std::to_string(key.z) + ") beyond the map's +-2^20 range");
+}
+
 void check_range(const common::BlockIndex& key) {
-  if (!EvidenceGrid::in_range(key)) {
-    throw std::invalid_argument("block (" + std::to_string(key.x) + ", " + std::to_string(key.y) +
-                                ", " + std::to_string(key.z) + ") beyond the map's +-2^20 range");
-  }
+  if (!EvidenceGrid::in_range(key)) throw_out_of_range(key);
 }
 
 }  // namespace
@@ -36,6 +38,8 @@ EvidenceGrid& EvidenceGrid::operator=(EvidenceGrid&&) noexcept = default;
 EvidenceGrid::EvidenceGrid(const EvidenceGrid& other)
     : EvidenceGrid(other.block_side_, other.channels_) {
   updates_ = other.updates_;
+  table_.reset(other.size());
+  reserve(other.size());
   other.for_each_block([&](const common::BlockIndex& key, const Block& block) {
     block_at(key).restore(block.evidence(), block.observed_words());
   });
@@ -98,9 +102,7 @@ void EvidenceGrid::add_block(const common::BlockIndex& key, std::span<const floa
 
 void EvidenceGrid::put_block(const common::BlockIndex& key, std::span<const float> evidence) {
   check_block(key, evidence);
-  Block& block = block_at(key);
-  block.clear();
-  block.add_evidence(evidence);
+  block_at(key).assign(evidence);
 }
 
 void EvidenceGrid::restore_block(const common::BlockIndex& key, std::span<const float> evidence,
@@ -118,6 +120,10 @@ bool EvidenceGrid::evict(const common::BlockIndex& key) {
   resident_[id] = 0;
   ++evicted_;
   return true;
+}
+
+void EvidenceGrid::reserve(std::size_t blocks) {
+  arena_.reserve(blocks * (block_floats() * sizeof(float) + 64));
 }
 
 float* EvidenceGrid::new_storage() {

@@ -32,6 +32,9 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& f
   const common::MapGrid from_grid = from_params.grid();
   const common::MapGrid to_grid = to_params.grid();
   const auto channels = static_cast<std::size_t>(to_params.channels());
+  // Neighbouring target cells mostly share a block: look it up once per run of them.
+  Block* target_block = nullptr;
+  common::BlockIndex target_key;
   layer.for_each_block([&](const common::BlockIndex& key, const Block& block) {
     // Bounding box of the source block in the target frame; every target cell whose centre
     // maps back into this block lies inside it.
@@ -59,7 +62,14 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& f
               static_cast<std::size_t>(from_grid.local_index(source, key)) * channels;
           const std::span<const float> values(block.evidence().data() + offset, channels);
           if (!any_nonzero(values)) continue;
-          std::copy(values.begin(), values.end(), out.cell(target).begin());
+          const common::BlockIndex key_of_target = to_grid.block_of(target);
+          if (target_block == nullptr || key_of_target != target_key) {
+            target_block = &out.block_at(key_of_target);
+            target_key = key_of_target;
+          }
+          const int local = to_grid.local_index(target, target_key);
+          std::copy(values.begin(), values.end(), target_block->cell_evidence_mutable(local));
+          target_block->mark_observed(local);
         }
       }
     }

@@ -23,7 +23,10 @@ SemanticMap::SemanticMap(const MapParams& params, SourceId robot)
       layers_(layered_params(params)),
       robot_(robot),
       grid_(&layers_.layer(robot)),
-      inserter_(std::make_unique<detail::TileInserter>(params)) {}
+      inserter_(std::make_unique<detail::TileInserter>(params)) {
+  // A live map soon holds many MB: 32 MiB of storage at once, in huge pages.
+  grid_->reserve((std::size_t{32} << 20) / (grid_->block_floats() * sizeof(float)));
+}
 
 SemanticMap::~SemanticMap() = default;
 SemanticMap::SemanticMap(SemanticMap&&) noexcept = default;

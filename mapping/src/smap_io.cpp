@@ -240,6 +240,7 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
   const std::size_t block_floats = probe.block_floats();
   // Smallest possible block record; bounds counts before anything is allocated.
   const std::size_t block_record = 5 * 4 + block_floats * sizeof(float) + 4;
+  std::vector<float> values;  // one block, reused
   try {
     for (std::uint32_t layer = 0; layer < header.layers; ++layer) {
       const std::size_t start = r.offset();
@@ -277,7 +278,7 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
         if (!EvidenceGrid::in_range(key)) {
           r.fail_at(block_start, block_where + ": block key beyond the map's +-2^20 range");
         }
-        std::vector<float> values(block_floats);
+        values.resize(block_floats);
         std::memcpy(values.data(), raw.data(), raw.size());
         if (!std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); })) {
           r.fail_at(block_start, block_where + ": non-finite evidence");

@@ -135,6 +135,20 @@ TEST(LogOddsMap, CountsBadPointsAndSkipsThem) {
   EXPECT_FALSE(map.summary_at({0.05, 0.55, 0.05}).occupied);
 }
 
+// Cells beyond the block table's +-2^20 blocks are bad points, not a crash; a scan taken from
+// such an origin leaves the map as it was.
+TEST(LogOddsMap, PointsAndOriginsBeyondTheGridAreRejected) {
+  LogOddsMap map(logodds_params(4), 1);
+  common::LabeledCloud cloud;
+  cloud.points = {{0.55f, 0.05f, 0.05f}, {1e9f, 0.0f, 0.0f}};
+  cloud.labels = {1, 1};
+  EXPECT_EQ(map.insert(cloud).rejected, 1u);
+  const std::size_t blocks = map.layers().resident_blocks();
+  cloud.origin = {0.0f, -3e8f, 0.0f};
+  EXPECT_EQ(map.insert(cloud).rejected, 2u);
+  EXPECT_EQ(map.layers().resident_blocks(), blocks);
+}
+
 TEST(LogOddsMap, RejectsCloudWithMismatchedLabels) {
   LogOddsMap map(logodds_params(), 1);
   common::LabeledCloud cloud;

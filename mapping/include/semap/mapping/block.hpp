@@ -52,8 +52,8 @@ class Block {
   // Adds evidence for every cell; cells given any non-zero value become observed. This is how
   // maps are merged and files are read.
   void add_evidence(std::span<const float> evidence);
-  // Zero evidence, nothing observed.
-  void clear();
+  // Replaces the evidence; cells with any non-zero value are observed, the others not.
+  void assign(std::span<const float> evidence);
 
   // Bytes of this block (evidence, observed bits and the object itself).
   std::size_t bytes() const;

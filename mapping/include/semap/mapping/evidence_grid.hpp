@@ -61,6 +61,10 @@ class EvidenceGrid {
                      std::span<const std::uint64_t> observed);
   // Drops the block at `key` from memory; false when it is not in memory.
   bool evict(const common::BlockIndex& key);
+  // Storage for `blocks` more blocks in one piece: a map that will grow large asks for it at
+  // once (a huge-page mapping, address space only until blocks are written), a small one
+  // (a tile, a merge) does not. Throws std::bad_alloc when the system refuses.
+  void reserve(std::size_t blocks);
 
   // Calls f(const common::BlockIndex&, const Block&) for every block in memory, in the order
   // they were first created.
@@ -93,7 +97,7 @@ class EvidenceGrid {
   int block_side_;
   int channels_;
   std::uint64_t updates_ = 0;
-  VoxelHashMap table_;                    // block key -> position in blocks_
+  VoxelHashMap table_{16};                // block key -> position in blocks_ (grows)
   std::vector<common::BlockIndex> keys_;  // per position
   BlockArena arena_;                      // before blocks_: they borrow its storage
   std::deque<Block> blocks_;              // a deque: references stay valid as blocks are added
