@@ -43,26 +43,22 @@ void EstimationStage::run(std::stop_token stop) {
   share_stats();
 }
 
-// Feeds what the rings hold in stamp order: the IMU and GNSS drivers run on separate threads,
-// so a fix may be popped before IMU samples that precede it.
+// Feeds what the rings hold. The IMU and GNSS drivers run on separate threads, so a fix may
+// be popped before IMU samples that precede it: the estimator holds it until the IMU reaches its
+// stamp (the one place sensor streams are put in time order), so fixes go in first.
 bool EstimationStage::drain_sensors() {
   std::array<common::ImuSample, 64> imu_batch;
   std::array<common::GnssFix, 8> gnss_batch;
   const std::size_t n_imu = imu_ring_.try_pop_batch(imu_batch);
   const std::size_t n_gnss = gnss_ring_.try_pop_batch(gnss_batch);
-  std::size_t i = 0;
-  std::size_t g = 0;
-  while (i < n_imu || g < n_gnss) {
-    if (g < n_gnss && (i == n_imu || gnss_batch[g].stamp <= imu_batch[i].stamp)) {
-      estimator_.add_gnss(gnss_batch[g++]);
-      ++stage_.figures().gnss_fixes;
-    } else {
-      last_imu_ = imu_batch[i];
-      estimator_.add_imu(imu_batch[i++]);
-      ++stage_.figures().imu_samples;
-      if (stage_.figures().heading_settled) {
-        if (auto pose = estimator_.pose_at(estimator_.filter_time())) new_poses_.push_back(*pose);
-      }
+  for (std::size_t g = 0; g < n_gnss; ++g) estimator_.add_gnss(gnss_batch[g]);
+  stage_.figures().gnss_fixes += n_gnss;
+  for (std::size_t i = 0; i < n_imu; ++i) {
+    last_imu_ = imu_batch[i];
+    estimator_.add_imu(imu_batch[i]);
+    ++stage_.figures().imu_samples;
+    if (stage_.figures().heading_settled) {
+      if (auto pose = estimator_.pose_at(estimator_.filter_time())) new_poses_.push_back(*pose);
     }
   }
   if (n_imu > 0) {

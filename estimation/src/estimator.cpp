@@ -90,11 +90,14 @@ void Estimator::add_gnss(const common::GnssFix& fix) {
         ->info("local ENU frame anchored at {:.8f}, {:.8f}, {:.2f}", fix.latitude_deg,
                fix.longitude_deg, fix.altitude_m);
   }
-  if (!initialised_) {
+  if (!initialised_ && fix.stamp <= filter_time_) {
+    // The IMU is already past it: it anchors the filter as it is.
     init_fix_ = fix;
     try_initialise();
     return;
   }
+  // Fixes ahead of the IMU wait here until the IMU reaches their stamp: callers feed the two
+  // streams in any order and the filter applies them in stamp order.
   if (!gnss_buffer_.push(fix, filter_time_)) {
     common::logger("estimation")
         ->debug("GNSS fix at {:.6f} s not buffered (late or duplicate; filter at {:.6f} s)",
@@ -105,6 +108,7 @@ void Estimator::add_gnss(const common::GnssFix& fix) {
 void Estimator::process_imu(const QueuedImu& queued) {
   const common::ImuSample& s = queued.sample;
   if (!initialised_) {
+    while (auto fix = gnss_buffer_.pop_until(s.stamp)) init_fix_ = *fix;  // the newest anchors
     collect_init_sample(s);
     return;
   }
