@@ -7,21 +7,21 @@
 
 namespace semap::onboard {
 
-DdsOutputs::DdsOutputs(const OnboardConfig& config, const dds_idl::BlockSource& map_blocks)
+DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& map,
+                       const dds_idl::BlockSource& map_blocks)
     : config_(config),
-      participant_(static_cast<dds_domainid_t>(config.dds.domain)),
-      odometry_topic_(participant_,
-                      dds_idl::topic_name(config.dds.ns, dds_idl::SemapTopic::kOdometry),
+      participant_(static_cast<dds_domainid_t>(config.domain)),
+      odometry_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kOdometry),
                       dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
       odometry_writer_(participant_, odometry_topic_,
                        dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
-      health_topic_(participant_, dds_idl::topic_name(config.dds.ns, dds_idl::SemapTopic::kHealth),
+      health_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kHealth),
                     dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
       health_writer_(participant_, health_topic_, dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
       map_publisher_(participant_,
-                     dds_idl::MapPublisherConfig{config.dds.ns, config.dds.frame_id,
-                                                 config.dds.publish_hz, config.dds.cloud_hz},
-                     describe_map(config), map_blocks) {}
+                     dds_idl::MapPublisherConfig{config.ns, config.frame_id, config.publish_hz,
+                                                 config.cloud_hz},
+                     map, map_blocks) {}
 
 // Only joins: the map view may be gone by now (stop() is what publishes the last changes).
 DdsOutputs::~DdsOutputs() { publisher_stage_.stop(); }
@@ -80,13 +80,13 @@ void DdsOutputs::publish_pose(const PoseOutput& pose) {
   p.pose_covariance.bottomRightCorner<3, 3>() = pose.rotation_covariance;
   dds_idl::msg::Odometry msg{};
   const std::string child = "base_link";
-  dds_idl::to_msg(p, config_.dds.frame_id, child, msg);
+  dds_idl::to_msg(p, config_.frame_id, child, msg);
   odometry_writer_.write(msg);
   odometry_written_.fetch_add(1);
 }
 
 void DdsOutputs::publish_health(const dds_idl::HealthReport& report) {
-  const dds_idl::HealthMessage m(report, config_.dds.frame_id);
+  const dds_idl::HealthMessage m(report, config_.frame_id);
   health_writer_.write(m.get());
   ++health_written_;
 }

@@ -26,7 +26,8 @@ namespace semap::onboard {
 class DdsOutputs {
  public:
   // `map_blocks` (the mapping stage's view) outlives the publisher thread: stop() first.
-  DdsOutputs(const OnboardConfig& config, const dds_idl::BlockSource& map_blocks);
+  DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& map,
+             const dds_idl::BlockSource& map_blocks);
   ~DdsOutputs();
 
   // The map publisher's thread; stop() publishes what changed last before it returns.
@@ -46,7 +47,7 @@ class DdsOutputs {
   std::size_t map_pending() const;
 
  private:
-  const OnboardConfig& config_;
+  const DdsConfig& config_;
   dds_idl::Participant participant_;
   dds_idl::Topic<dds_idl::msg::Odometry> odometry_topic_;
   dds_idl::Writer<dds_idl::msg::Odometry> odometry_writer_;

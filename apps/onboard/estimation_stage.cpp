@@ -11,7 +11,7 @@
 
 namespace semap::onboard {
 
-EstimationStage::EstimationStage(const OnboardConfig& config,
+EstimationStage::EstimationStage(const EstimationStageConfig& config,
                                  common::SpscRing<common::ImuSample>& imu,
                                  common::SpscRing<common::GnssFix>& gnss, SharedPoseHistory& poses,
                                  PoseSink pose_sink)
@@ -95,7 +95,7 @@ void EstimationStage::publish_pose() {
   // The covariance is read only for a pose that is published (odometry rate).
   const common::Stamp stamp = estimator_.filter_time();
   if (stamp < next_pose_publish_) return;
-  next_pose_publish_ = stamp + 1.0 / config_.dds.odometry_hz;
+  next_pose_publish_ = stamp + 1.0 / config_.odometry_hz;
   const estimation::NavFilter& filter = estimator_.filter();
   const estimation::NavState state = filter.state();
   PoseOutput out;

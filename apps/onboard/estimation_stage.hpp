@@ -37,6 +37,14 @@ struct PoseOutput {
   Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Identity();
 };
 
+// What the estimation stage reads: the `estimator` section, and from `map` and `dds` the heading
+// that starts mapping and the odometry rate.
+struct EstimationStageConfig {
+  estimation::EstimatorConfig estimator;
+  double map_start_heading_sigma_deg = 3.0;
+  double odometry_hz = 50.0;
+};
+
 // Owns the Estimator on its own thread: drains the IMU and GNSS rings in stamp order and
 // shares the filter's poses with the perception stage, which poses frames at their stamps,
 // once the filter's heading has settled (map.start_heading_sigma_deg).
@@ -44,7 +52,7 @@ class EstimationStage {
  public:
   using PoseSink = std::function<void(const PoseOutput&)>;
 
-  EstimationStage(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu,
+  EstimationStage(const EstimationStageConfig& config, common::SpscRing<common::ImuSample>& imu,
                   common::SpscRing<common::GnssFix>& gnss, SharedPoseHistory& poses,
                   PoseSink pose_sink);
   ~EstimationStage();
@@ -64,7 +72,7 @@ class EstimationStage {
   void check_heading();
   void share_stats();
 
-  const OnboardConfig& config_;
+  EstimationStageConfig config_;
   common::SpscRing<common::ImuSample>& imu_ring_;
   common::SpscRing<common::GnssFix>& gnss_ring_;
   SharedPoseHistory& poses_;

@@ -182,7 +182,7 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
     try {
       perception_stage = std::make_unique<onboard::PerceptionStage>(
           config.camera, config.depth,
-          onboard::make_segmenter(config.segmenter, config.map.num_classes), colour_ring,
+          onboard::make_segmenter(config.segmenter, config.map.params.num_classes), colour_ring,
           config.depth.source == onboard::DepthSource::kAligned ? &depth_ring : nullptr, poses,
           cloud_ring);
       log->info("perception: {}", perception_stage->describe());
@@ -203,13 +203,13 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
 
   std::unique_ptr<onboard::DdsOutputs> dds;
 
-  std::filesystem::path checkpoint_path = config.map_checkpoint_path;
-  if (checkpoint_path.empty() && !config.map_save_path.empty()) {
-    checkpoint_path = config.map_save_path + ".log";
+  std::filesystem::path checkpoint_path = config.map.checkpoint_path;
+  if (checkpoint_path.empty() && !config.map.save_path.empty()) {
+    checkpoint_path = config.map.save_path + ".log";
   }
   if (checkpoint_path.empty() && report) checkpoint_path = report->dir() / "map.log";
   onboard::MappingStage mapping_stage(
-      config, cloud_ring,
+      config.map, cloud_ring,
       config.dds.enabled
           ? onboard::MappingStage::BlockSink([&](const std::vector<common::BlockIndex>& changed) {
               dds->blocks_changed(changed);
@@ -219,9 +219,11 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   // The publisher reads the map through the mapping stage's view (it is set before the
   // mapping thread starts).
   if (config.dds.enabled)
-    dds = std::make_unique<onboard::DdsOutputs>(config, mapping_stage.blocks());
+    dds = std::make_unique<onboard::DdsOutputs>(config.dds, onboard::describe_map(config.map),
+                                                mapping_stage.blocks());
   // A resumed map lives in the frame it was built in: the estimator anchors there too.
-  onboard::OnboardConfig estimation_config = config;
+  onboard::EstimationStageConfig estimation_config{
+      config.estimator, config.map.start_heading_sigma_deg, config.dds.odometry_hz};
   if (const auto frame = mapping_stage.map_frame()) {
     const estimation::Geodetic anchor{(*frame)[0], (*frame)[1], (*frame)[2]};
     const auto& given = config.estimator.anchor;
@@ -324,9 +326,9 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
 
   const auto est = estimation_stage.stats();
   const auto map = mapping_stage.stats();
-  if (!config.map_save_path.empty()) {
-    mapping::write_smap(config.map_save_path, mapping_stage.map().layers());
-    log->info("map saved to {}", config.map_save_path);
+  if (!config.map.save_path.empty()) {
+    mapping::write_smap(config.map.save_path, mapping_stage.map().layers());
+    log->info("map saved to {}", config.map.save_path);
   }
   if (report) {
     const auto path = report->dir() / "map.smap";
@@ -388,9 +390,9 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
         1e3 * map.checkpoint.max_write_s, static_cast<double>(map.checkpoint.log_bytes) / 1e6,
         map.checkpoint.resumed_blocks, map.checkpoint.resumed_scans);
   }
-  if (config.map_memory_radius_m > 0.0) {
+  if (config.map.memory_radius_m > 0.0) {
     std::printf("map paging       : radius %.0f m, %lu blocks paged out, %lu paged in\n",
-                config.map_memory_radius_m, map.pager.evicted, map.pager.restored);
+                config.map.memory_radius_m, map.pager.evicted, map.pager.restored);
   }
   if (dds) {
     const auto m = dds->map_counters();
@@ -467,7 +469,7 @@ int main(int argc, char** argv) {
   }
   if (duration) config.rig.duration_s = *duration;
   if (domain) config.dds.domain = *domain;
-  if (resume) config.map_resume = true;
+  if (resume) config.map.resume = true;
   semap::common::setup_logging(config.log_level);
   if (config.dds.enabled && !config.dds.cyclone_config.empty() && !std::getenv("CYCLONEDDS_URI")) {
     setenv("CYCLONEDDS_URI", ("file://" + config.dds.cyclone_config.string()).c_str(), 1);

@@ -9,13 +9,13 @@
 
 namespace semap::onboard {
 
-dds_idl::MapDescription describe_map(const OnboardConfig& config) {
+dds_idl::MapDescription describe_map(const MappingConfig& config) {
   dds_idl::MapDescription d;
-  d.resolution = config.map.resolution;
-  d.block_cells = static_cast<std::uint16_t>(config.map.cells_per_side());
-  d.num_classes = static_cast<std::uint16_t>(config.map.num_classes);
-  d.class_names = config.map_palette.names;
-  for (const mapping::Rgb& rgb : config.map_palette.colors) {
+  d.resolution = config.params.resolution;
+  d.block_cells = static_cast<std::uint16_t>(config.params.cells_per_side());
+  d.num_classes = static_cast<std::uint16_t>(config.params.num_classes);
+  d.class_names = config.palette.names;
+  for (const mapping::Rgb& rgb : config.palette.colors) {
     d.class_colors.push_back(std::uint32_t{rgb[0]} << 16 | std::uint32_t{rgb[1]} << 8 | rgb[2]);
   }
   return d;
@@ -32,42 +32,43 @@ dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common
                                        observed, params.prior, params.unknown_variance, version);
 }
 
-MappingStage::MappingStage(const OnboardConfig& config,
+MappingStage::MappingStage(const MappingConfig& config,
                            common::SpscRing<common::LabeledCloud>& clouds, BlockSink sink,
                            const std::filesystem::path& checkpoint_path)
-    : config_(config), clouds_(clouds), sink_(std::move(sink)), map_(config.map, config.robot_id) {
-  if (checkpoint_path.empty() || config.map_checkpoint_s <= 0.0) return;
+    : config_(config),
+      clouds_(clouds),
+      sink_(std::move(sink)),
+      map_(config.params, config.robot_id) {
+  if (checkpoint_path.empty() || config.checkpoint_s <= 0.0) return;
   if (checkpoint_path.has_parent_path()) {
     std::filesystem::create_directories(checkpoint_path.parent_path());
   }
-  if (!config.map_resume && std::filesystem::exists(checkpoint_path)) {
+  if (!config.resume && std::filesystem::exists(checkpoint_path)) {
     // A new map: the previous run's checkpoint is kept beside it, not continued or deleted.
     std::filesystem::path previous = checkpoint_path;
     previous += ".previous";
     std::filesystem::rename(checkpoint_path, previous);
     common::logger("mapping")->info("previous map checkpoint moved to {}", previous.string());
   }
-  const bool paged = config.map_memory_radius_m > 0.0;
+  const bool paged = config.memory_radius_m > 0.0;
   checkpoint_ = std::make_unique<mapping::MapCheckpoint>(
       map_,
-      mapping::CheckpointParams{.path = checkpoint_path,
-                                .interval_s = config.map_checkpoint_s,
-                                .resume = config.map_resume},
+      mapping::CheckpointParams{
+          .path = checkpoint_path, .interval_s = config.checkpoint_s, .resume = config.resume},
       !paged);
   const auto log = common::logger("mapping");
   if (!checkpoint_->damage().empty()) {
     log->warn("map checkpoint: {}; resuming from the last complete checkpoint",
               checkpoint_->damage());
   }
-  if (config.map_resume) {
+  if (config.resume) {
     const auto stats = checkpoint_->stats();
     log->info("map resumed from {}: {} blocks of {} scans{}", checkpoint_path.string(),
               paged ? checkpoint_->log().blocks().size() : stats.resumed_blocks,
               stats.resumed_scans, paged ? " (paged in as the robot gets near)" : "");
   }
   if (paged) {
-    pager_ =
-        std::make_unique<mapping::MapPager>(map_, checkpoint_->log(), config.map_memory_radius_m);
+    pager_ = std::make_unique<mapping::MapPager>(map_, checkpoint_->log(), config.memory_radius_m);
   }
   stage_.figures().checkpoint = checkpoint_->stats();
   stage_.figures().map = map_.stats();
@@ -95,7 +96,7 @@ void MappingStage::record_map_frame(const mapping::MapFrame& frame) {
 const mapping::SemanticMap& MappingStage::map() {
   if (!pager_) return map_;
   if (!full_map_) {
-    full_map_ = std::make_unique<mapping::SemanticMap>(config_.map, config_.robot_id);
+    full_map_ = std::make_unique<mapping::SemanticMap>(config_.params, config_.robot_id);
     checkpoint_->log().load_all(*full_map_);
   }
   return *full_map_;
@@ -104,8 +105,8 @@ const mapping::SemanticMap& MappingStage::map() {
 MappingStageStats MappingStage::stats() const { return stage_.stats(); }
 
 void MappingStage::run(std::stop_token stop) {
-  tbb::task_arena arena(config_.map_threads);
-  if (config_.map_resume && sink_) {
+  tbb::task_arena arena(config_.threads);
+  if (config_.resume && sink_) {
     // Subscribers get the resumed map before anything new.
     std::vector<common::BlockIndex> resumed;
     if (pager_) {
@@ -176,12 +177,13 @@ bool MappingStage::read(const common::BlockIndex& index, dds_idl::BlockSnapshot&
   std::vector<float> evidence;
   std::vector<std::uint64_t> observed_words;
   if (!pager_ || !checkpoint_->log().read(index, evidence, observed_words)) return false;
-  std::vector<std::uint8_t> observed(static_cast<std::size_t>(config_.map.cells_per_block()));
+  std::vector<std::uint8_t> observed(static_cast<std::size_t>(config_.params.cells_per_block()));
   for (std::size_t c = 0; c < observed.size(); ++c) {
     observed[c] = (observed_words[c / 64] >> (c % 64)) & 1u;
   }
-  out = dds_idl::snapshot_of_evidence(index, config_.map.grid(), config_.map.num_classes, evidence,
-                                      observed, config_.map.prior, config_.map.unknown_variance, v);
+  out = dds_idl::snapshot_of_evidence(index, config_.params.grid(), config_.params.num_classes,
+                                      evidence, observed, config_.params.prior,
+                                      config_.params.unknown_variance, v);
   return true;
 }
 

@@ -45,7 +45,7 @@ class MappingStage : private dds_idl::BlockSource {
 
   // Throws mapping::BlockLogError when the checkpoint log cannot be opened or belongs to a map
   // with other parameters (it is never overwritten).
-  MappingStage(const OnboardConfig& config, common::SpscRing<common::LabeledCloud>& clouds,
+  MappingStage(const MappingConfig& config, common::SpscRing<common::LabeledCloud>& clouds,
                BlockSink sink, const std::filesystem::path& checkpoint_path);
   ~MappingStage();
   MappingStage(const MappingStage&) = delete;
@@ -78,7 +78,7 @@ class MappingStage : private dds_idl::BlockSource {
   void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const override;
   bool read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
 
-  const OnboardConfig& config_;
+  const MappingConfig& config_;
   common::SpscRing<common::LabeledCloud>& clouds_;
   BlockSink sink_;
   // The mapping thread writes the map (and versions_) under an exclusive lock; readers share.
@@ -93,7 +93,7 @@ class MappingStage : private dds_idl::BlockSource {
 };
 
 // The map's shape and its palette's class names and colours (0xRRGGBB), for MapInfo.
-dds_idl::MapDescription describe_map(const OnboardConfig& config);
+dds_idl::MapDescription describe_map(const MappingConfig& config);
 
 // A block of the map in the form the DDS layer publishes.
 dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,

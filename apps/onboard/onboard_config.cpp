@@ -190,31 +190,31 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   read_segmenter(root.section_or_empty("segmenter"), c.segmenter);
   c.estimator = estimation::load_estimator_config(root.section_or_empty("estimator"));
   const auto map = root.section_or_empty("map");
-  c.map = mapping::map_params_from_config(map, c.map);
-  c.map_save_path = map.get<std::string>("save_path", "");
-  c.map_palette = map.has("palette")
-                      ? mapping::load_palette(map.get<std::string>("palette"), c.map.num_classes)
-                      : mapping::ClassPalette::defaults(c.map.num_classes);
-  c.map_checkpoint_path = map.get<std::string>("checkpoint_path", "");
-  c.map_checkpoint_s = map.get_in_range("checkpoint_s", c.map_checkpoint_s, 0.0, 3600.0);
-  c.map_resume = map.get<bool>("resume", false);
-  c.map_memory_radius_m = map.get_in_range("memory_radius_m", 0.0, 0.0, 1e6);
-  if (c.map_memory_radius_m > 0.0) {
+  c.map.params = mapping::map_params_from_config(map, c.map.params);
+  c.map.save_path = map.get<std::string>("save_path", "");
+  c.map.palette = map.has("palette") ? mapping::load_palette(map.get<std::string>("palette"),
+                                                             c.map.params.num_classes)
+                                     : mapping::ClassPalette::defaults(c.map.params.num_classes);
+  c.map.checkpoint_path = map.get<std::string>("checkpoint_path", "");
+  c.map.checkpoint_s = map.get_in_range("checkpoint_s", c.map.checkpoint_s, 0.0, 3600.0);
+  c.map.resume = map.get<bool>("resume", false);
+  c.map.memory_radius_m = map.get_in_range("memory_radius_m", 0.0, 0.0, 1e6);
+  if (c.map.memory_radius_m > 0.0) {
     // Every block a scan can reach must be in memory when it is inserted.
-    const double block_diagonal = std::sqrt(3.0) * c.map.block_size();
-    const double reach = c.map.max_range + c.map.ell + block_diagonal;
-    if (c.map.max_range <= 0.0f || c.map_memory_radius_m < reach) {
+    const double block_diagonal = std::sqrt(3.0) * c.map.params.block_size();
+    const double reach = c.map.params.max_range + c.map.params.ell + block_diagonal;
+    if (c.map.params.max_range <= 0.0f || c.map.memory_radius_m < reach) {
       map.reject("memory_radius_m", "must be at least max_range + ell + one block diagonal (" +
                                         std::to_string(reach) + " m), with max_range > 0");
     }
-    if (c.map_checkpoint_s <= 0.0) {
+    if (c.map.checkpoint_s <= 0.0) {
       map.reject("memory_radius_m", "needs the checkpoint log (checkpoint_s > 0) to page into");
     }
   }
-  c.map_threads = static_cast<int>(map.get_in_range("threads", 2, 1, 64));
-  c.robot_id = static_cast<mapping::SourceId>(map.get_in_range("robot_id", 1, 1, 65535));
-  c.map_start_heading_sigma_deg =
-      map.get_in_range("start_heading_sigma_deg", c.map_start_heading_sigma_deg, 0.01, 180.0);
+  c.map.threads = static_cast<int>(map.get_in_range("threads", 2, 1, 64));
+  c.map.robot_id = static_cast<mapping::SourceId>(map.get_in_range("robot_id", 1, 1, 65535));
+  c.map.start_heading_sigma_deg =
+      map.get_in_range("start_heading_sigma_deg", c.map.start_heading_sigma_deg, 0.01, 180.0);
   map.finish();
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);
@@ -240,7 +240,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
     if (camera.has("format")) camera.reject("format", "rig.camera_output sets it (BGR24)");
     c.camera.driver.format = common::PixelFormat::kBgr24;
   }
-  c.map.validate();
+  c.map.params.validate();
   return c;
 }
 

@@ -63,6 +63,27 @@ struct DdsConfig {
   double odometry_hz = 50.0;
 };
 
+// The `map:` section: the live map and what the mapping stage does with it.
+struct MappingConfig {
+  mapping::MapParams params;
+  std::string save_path;  // .smap written at exit when set
+  // Names and colours of the map's classes (map.palette, a YAML file as semap-export reads),
+  // published in MapInfo for planners and viewers.
+  mapping::ClassPalette palette;
+  // The live map's crash-safe checkpoint (mapping::MapCheckpoint): a block log written every
+  // checkpoint_s (0: none). An empty path means <save_path>.log, or map.log in the --report
+  // directory, or no checkpoint when neither is given.
+  std::string checkpoint_path;
+  double checkpoint_s = 10.0;
+  bool resume = false;             // continue the map in the checkpoint at start
+  double memory_radius_m = 0.0;    // > 0: blocks farther away go to the checkpoint log
+  mapping::SourceId robot_id = 1;  // this robot's evidence layer in saved and merged maps
+  int threads = 2;
+  // Frames are mapped only once the filter's heading is known to within this (1 sigma):
+  // a filter that starts from a guessed heading would otherwise smear the map.
+  double start_heading_sigma_deg = 3.0;
+};
+
 struct OnboardConfig {
   RigConfig rig;
   ImuSourceConfig imu;
@@ -71,23 +92,7 @@ struct OnboardConfig {
   DepthConfig depth;
   SegmenterConfig segmenter;
   estimation::EstimatorConfig estimator;
-  mapping::MapParams map;
-  std::string map_save_path;  // .smap written at exit when set
-  // Names and colours of the map's classes (map.palette, a YAML file as semap-export reads),
-  // published in MapInfo for planners and viewers.
-  mapping::ClassPalette map_palette;
-  // The live map's crash-safe checkpoint (mapping::MapCheckpoint): a block log written every
-  // map_checkpoint_s (0: none). An empty path means <save_path>.log, or map.log in the
-  // --report directory, or no checkpoint when neither is given.
-  std::string map_checkpoint_path;
-  double map_checkpoint_s = 10.0;
-  bool map_resume = false;           // continue the map in the checkpoint at start
-  double map_memory_radius_m = 0.0;  // > 0: blocks farther away go to the checkpoint log
-  mapping::SourceId robot_id = 1;    // this robot's evidence layer in saved and merged maps
-  int map_threads = 2;
-  // Frames are mapped only once the filter's heading is known to within this (1 sigma):
-  // a filter that starts from a guessed heading would otherwise smear the map.
-  double map_start_heading_sigma_deg = 3.0;
+  MappingConfig map;
   DdsConfig dds;
   std::string log_level = "info";
 };

@@ -141,7 +141,7 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
 
   tbb::task_arena arena(o.threads);
   for (const int stride : {1, 2}) {
-    semap::mapping::SemanticMap map(config.map);
+    semap::mapping::SemanticMap map(config.map.params);
     const auto s = bench::time_ms(n, [&](int i) {
       const double t = i / kCameraHz;
       common::LabeledCloud cloud = onboard::to_world(clouds[stride - 1], bench::circle_pose(t, {}));
@@ -170,9 +170,9 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   seg.kind = onboard::SegmenterConfig::Kind::kOnnx;
   seg.model_card = model.card;
   onboard::PerceptionStage perception(config.camera, config.depth,
-                                      onboard::make_segmenter(seg, config.map.num_classes),
+                                      onboard::make_segmenter(seg, config.map.params.num_classes),
                                       colour_ring, &depth_ring, poses, cloud_ring);
-  onboard::MappingStage mapping(config, cloud_ring, nullptr, {});
+  onboard::MappingStage mapping(config.map, cloud_ring, nullptr, {});
 
   // The estimation stage's part: filter poses at 200 Hz, stamped now.
   const common::Stamp t0 = common::Stamp::now();
@@ -263,14 +263,14 @@ int main(int argc, char** argv) {
       perception::PinholeIntrinsics::from_fov(kWidth, kHeight, std::numbers::pi_v<float> / 2);
   config.depth.points.stride = o.stride;
   config.depth.points.max_range = 20.0f;
-  config.map.resolution = 0.2f;  // config/sim.yaml's map
-  config.map.block_depth = 3;
-  config.map.num_classes = kMapClasses;
-  config.map.ell = 0.5f;
-  config.map.free_res = 1.0f;
-  config.map.ds_res = 0.2f;
-  config.map.max_range = 20.0f;
-  config.map_threads = o.threads;
+  config.map.params.resolution = 0.2f;  // config/sim.yaml's map
+  config.map.params.block_depth = 3;
+  config.map.params.num_classes = kMapClasses;
+  config.map.params.ell = 0.5f;
+  config.map.params.free_res = 1.0f;
+  config.map.params.ds_res = 0.2f;
+  config.map.params.max_range = 20.0f;
+  config.map.threads = o.threads;
 
   const TempDir dir;
   const auto scene = bench::render_scene(config.camera, config.depth.depth_scale);

@@ -53,9 +53,9 @@ TEST(OnboardConfig, SimulatedRigExample) {
   EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
   EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
   EXPECT_EQ(c.rig.camera_image, SimCameraImage::kRgb);
-  EXPECT_DOUBLE_EQ(c.map_start_heading_sigma_deg, 3.0);
-  const auto segmenter = make_segmenter(c.segmenter, c.map.num_classes);
-  EXPECT_EQ(segmenter->num_classes(), c.map.num_classes);
+  EXPECT_DOUBLE_EQ(c.map.start_heading_sigma_deg, 3.0);
+  const auto segmenter = make_segmenter(c.segmenter, c.map.params.num_classes);
+  EXPECT_EQ(segmenter->num_classes(), c.map.params.num_classes);
 }
 
 TEST(OnboardConfig, RgbdRobotExample) {
@@ -72,10 +72,11 @@ TEST(OnboardConfig, RgbdRobotExample) {
   EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
   EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
   // The shipped model's classes are the map's.
-  EXPECT_EQ(make_segmenter(c.segmenter, c.map.num_classes)->num_classes(), c.map.num_classes);
-  EXPECT_EQ(c.map_palette.names.size(), static_cast<std::size_t>(c.map.num_classes));
-  EXPECT_TRUE(c.map_resume);
-  EXPECT_GT(c.map_memory_radius_m, c.map.max_range);
+  EXPECT_EQ(make_segmenter(c.segmenter, c.map.params.num_classes)->num_classes(),
+            c.map.params.num_classes);
+  EXPECT_EQ(c.map.palette.names.size(), static_cast<std::size_t>(c.map.params.num_classes));
+  EXPECT_TRUE(c.map.resume);
+  EXPECT_GT(c.map.memory_radius_m, c.map.params.max_range);
   // Pitched 10 degrees down: the optical axis points forward and down.
   const Eigen::Vector3f axis = c.camera.body_from_optical().linear() * Eigen::Vector3f::UnitZ();
   EXPECT_GT(axis.x(), 0.98f);
@@ -93,20 +94,20 @@ TEST(OnboardConfig, StereoRobotExample) {
 
 TEST(OnboardConfig, MapPaletteNamesTheClassesInMapInfo) {
   const auto c = load_onboard_config(kConfigDir / "sim.yaml");
-  ASSERT_EQ(c.map_palette.names.size(), 8u);
-  EXPECT_EQ(c.map_palette.names[3], "building");
-  EXPECT_EQ(c.map_palette.colors[1], (mapping::Rgb{128, 64, 128}));
-  const auto d = describe_map(c);
-  EXPECT_EQ(d.class_names, c.map_palette.names);
+  ASSERT_EQ(c.map.palette.names.size(), 8u);
+  EXPECT_EQ(c.map.palette.names[3], "building");
+  EXPECT_EQ(c.map.palette.colors[1], (mapping::Rgb{128, 64, 128}));
+  const auto d = describe_map(c.map);
+  EXPECT_EQ(d.class_names, c.map.palette.names);
   ASSERT_EQ(d.class_colors.size(), 8u);
   EXPECT_EQ(d.class_colors[1], 0x804080u);
 }
 
 TEST(OnboardConfig, MapCheckpointAndMemoryRadius) {
   const auto c = load_onboard_config(kConfigDir / "sim.yaml");
-  EXPECT_DOUBLE_EQ(c.map_checkpoint_s, 10.0);
-  EXPECT_FALSE(c.map_resume);
-  EXPECT_DOUBLE_EQ(c.map_memory_radius_m, 0.0);
+  EXPECT_DOUBLE_EQ(c.map.checkpoint_s, 10.0);
+  EXPECT_FALSE(c.map.resume);
+  EXPECT_DOUBLE_EQ(c.map.memory_radius_m, 0.0);
   // A radius a scan can reach beyond would split blocks between memory and the log.
   const std::string too_small = error_of(
       edited_sim("  save_path: build/sim_map.smap", "  save_path: x.smap\n  memory_radius_m: 5"));
