@@ -21,7 +21,9 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
       map_publisher_(participant_,
                      dds_idl::MapPublisherConfig{config.ns, config.frame_id, config.publish_hz,
                                                  config.cloud_hz},
-                     map, map_blocks) {}
+                     map, map_blocks) {
+  dds_idl::set_stamp_clock(config.stamp_clock);
+}
 
 // Only joins: the map view may be gone by now (stop() is what publishes the last changes).
 DdsOutputs::~DdsOutputs() { publisher_stage_.stop(); }

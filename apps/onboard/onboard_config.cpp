@@ -173,6 +173,8 @@ void read_dds(const ConfigSection& s, DdsConfig& dds) {
   dds.publish_hz = s.get_in_range("publish_hz", dds.publish_hz, 0.1, 100.0);
   dds.cloud_hz = s.get_in_range("cloud_hz", dds.cloud_hz, 0.0, 10.0);
   dds.odometry_hz = s.get_in_range("odometry_hz", dds.odometry_hz, 1.0, 1000.0);
+  dds.stamp_clock = dds_idl::stamp_clock_from_string(
+      s.get_choice("stamp_clock", "realtime", {"realtime", "monotonic"}));
   s.finish();
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "perception_config.hpp"
+#include "semap/dds_idl/converters.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/drivers/gnss_driver.hpp"
 #include "semap/estimation/estimator_config.hpp"
@@ -61,6 +62,8 @@ struct DdsConfig {
   double publish_hz = 2.0;
   double cloud_hz = 0.5;
   double odometry_hz = 50.0;
+  // Header stamps: ROS time (the system clock) or the pipeline's CLOCK_MONOTONIC.
+  dds_idl::StampClock stamp_clock = dds_idl::StampClock::kRealtime;
 };
 
 // The `map:` section: the live map and what the mapping stage does with it.

@@ -1,6 +1,11 @@
 #include "semap/dds_idl/converters.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <stdexcept>
+
+#include "semap/common/clock_offset.hpp"
 
 namespace semap::dds_idl {
 
@@ -40,13 +45,54 @@ void get_pose(const geometry_msgs_msg_dds__PoseWithCovariance_& in, PoseEstimate
 
 }  // namespace
 
+namespace {
+
+std::atomic<StampClock> g_stamp_clock{StampClock::kRealtime};
+
+// One offset for every writer and reader of the process, so a stamp and its inverse agree.
+struct SharedClockOffset {
+  std::mutex mutex;
+  common::ClockOffset offset;
+};
+
+SharedClockOffset& shared_offset() {
+  static SharedClockOffset shared;
+  return shared;
+}
+
+std::int64_t realtime_of(common::Stamp monotonic) {
+  SharedClockOffset& s = shared_offset();
+  std::lock_guard lock(s.mutex);
+  return s.offset.to_realtime(monotonic);
+}
+
+common::Stamp monotonic_of(std::int64_t realtime) {
+  SharedClockOffset& s = shared_offset();
+  std::lock_guard lock(s.mutex);
+  return s.offset.to_monotonic(realtime);
+}
+
+}  // namespace
+
+void set_stamp_clock(StampClock clock) { g_stamp_clock.store(clock); }
+
+StampClock stamp_clock() { return g_stamp_clock.load(); }
+
+StampClock stamp_clock_from_string(const std::string& name) {
+  if (name == "realtime") return StampClock::kRealtime;
+  if (name == "monotonic") return StampClock::kMonotonic;
+  throw std::invalid_argument("unknown stamp clock '" + name + "' (realtime or monotonic)");
+}
+
 msg::Time to_msg_time(common::Stamp stamp) {
-  const std::int64_t ns = std::max<std::int64_t>(stamp.ns, 0);
+  const std::int64_t out = stamp_clock() == StampClock::kRealtime ? realtime_of(stamp) : stamp.ns;
+  const std::int64_t ns = std::max<std::int64_t>(out, 0);
   return {static_cast<std::int32_t>(ns / kNsPerSec), static_cast<std::uint32_t>(ns % kNsPerSec)};
 }
 
 common::Stamp from_msg_time(const msg::Time& t) {
-  return common::Stamp(static_cast<std::int64_t>(t.sec_) * kNsPerSec + t.nanosec_);
+  const std::int64_t ns = static_cast<std::int64_t>(t.sec_) * kNsPerSec + t.nanosec_;
+  return stamp_clock() == StampClock::kRealtime ? monotonic_of(ns) : common::Stamp(ns);
 }
 
 void to_msg(const common::ImuSample& s, const std::string& frame_id, double gyro_variance,

@@ -151,7 +151,7 @@ CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {
       scm_timestamping ts{};
       std::memcpy(&ts, CMSG_DATA(c), sizeof(ts));
       if (ts.ts[0].tv_sec != 0 || ts.ts[0].tv_nsec != 0) {
-        frame.stamp = clock_.convert(ts.ts[0]);
+        frame.stamp = clock_.to_monotonic(common::Stamp::from_timespec(ts.ts[0]).ns);
       }
     } else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
       std::memcpy(&frame.kernel_drops, CMSG_DATA(c), sizeof(frame.kernel_drops));

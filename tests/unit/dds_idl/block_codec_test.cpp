@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/map_cloud.hpp"
 #include "semap/dds_idl/map_description.hpp"
 
@@ -26,7 +27,9 @@ BlockSnapshot sample_block(bool evidence) {
 TEST(BlockCodec, RoundTripKeepsEveryField) {
   for (bool evidence : {false, true}) {
     const BlockSnapshot b = sample_block(evidence);
+    set_stamp_clock(StampClock::kMonotonic);  // the stamp as it is, to check its fields
     const BlockMessage m(b, common::Stamp(1'500'000'123), "map");
+    set_stamp_clock(StampClock::kRealtime);
     EXPECT_EQ(m.get().header_.stamp_.sec_, 1);
     EXPECT_EQ(m.get().header_.stamp_.nanosec_, 500'000'123u);
     const DecodedBlock d = decode_block(m.get(), {});

@@ -2,10 +2,21 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <ctime>
+
 namespace semap::dds_idl {
 namespace {
 
-TEST(Converters, TimeSplitsIntoSecondsAndNanoseconds) {
+// Sets the process-wide stamp clock for one test and restores the default after it.
+class StampClockScope {
+ public:
+  explicit StampClockScope(StampClock clock) { set_stamp_clock(clock); }
+  ~StampClockScope() { set_stamp_clock(StampClock::kRealtime); }
+};
+
+TEST(Converters, MonotonicTimeSplitsIntoSecondsAndNanoseconds) {
+  const StampClockScope monotonic(StampClock::kMonotonic);
   const msg::Time t = to_msg_time(common::Stamp(12'345'678'901));
   EXPECT_EQ(t.sec_, 12);
   EXPECT_EQ(t.nanosec_, 345'678'901u);
@@ -13,6 +24,25 @@ TEST(Converters, TimeSplitsIntoSecondsAndNanoseconds) {
   const msg::Time negative = to_msg_time(common::Stamp(-5));
   EXPECT_EQ(negative.sec_, 0);
   EXPECT_EQ(negative.nanosec_, 0u);
+}
+
+// By default headers carry ROS time: the system clock's now for a stamp of now (not seconds
+// since boot), and a reader in the same process gets the monotonic stamp back.
+TEST(Converters, HeadersCarryRosTimeByDefault) {
+  ASSERT_EQ(stamp_clock(), StampClock::kRealtime);
+  timespec before{};
+  ::clock_gettime(CLOCK_REALTIME, &before);
+  const common::Stamp now = common::Stamp::now();
+  const msg::Time t = to_msg_time(now);
+  timespec after{};
+  ::clock_gettime(CLOCK_REALTIME, &after);
+  EXPECT_GT(t.sec_, 1'600'000'000);  // after 2020: wall time, not uptime
+  const std::int64_t ns = static_cast<std::int64_t>(t.sec_) * 1'000'000'000 + t.nanosec_;
+  EXPECT_GE(ns, common::Stamp::from_timespec(before).ns - 1'000'000);
+  EXPECT_LE(ns, common::Stamp::from_timespec(after).ns + 1'000'000);
+  EXPECT_LE(std::abs(from_msg_time(t).ns - now.ns), 10'000);  // exact unless a refresh fell between
+  EXPECT_EQ(stamp_clock_from_string("monotonic"), StampClock::kMonotonic);
+  EXPECT_THROW(stamp_clock_from_string("gps"), std::invalid_argument);
 }
 
 TEST(Converters, ImuFollowsRosConventions) {

@@ -10,8 +10,19 @@
 
 namespace semap::dds_idl {
 
-// Stamps go out as they are: nanoseconds of the robot's CLOCK_MONOTONIC split into sec/nanosec.
-// Negative stamps are clamped to zero (builtin_interfaces/Time cannot carry them meaningfully).
+// The clock of the stamps in DDS headers. Inside, the pipeline's stamps are CLOCK_MONOTONIC;
+// at the DDS boundary they become kRealtime, ROS time (the system clock, which TF, RViz, nav2
+// and message_filters compare against), through common::ClockOffset, or stay kMonotonic.
+enum class StampClock { kRealtime, kMonotonic };
+
+// Process-wide, set once at start (dds.stamp_clock); kRealtime unless set.
+void set_stamp_clock(StampClock clock);
+StampClock stamp_clock();
+// "realtime" | "monotonic"; throws std::invalid_argument otherwise.
+StampClock stamp_clock_from_string(const std::string& name);
+
+// A pipeline stamp as a header stamp in the stamp clock, split into sec/nanosec, and back.
+// Negative times are clamped to zero (builtin_interfaces/Time cannot carry them meaningfully).
 msg::Time to_msg_time(common::Stamp stamp);
 common::Stamp from_msg_time(const msg::Time& t);
 

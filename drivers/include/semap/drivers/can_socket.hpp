@@ -4,8 +4,8 @@
 #include <span>
 #include <string>
 
+#include "semap/common/clock_offset.hpp"
 #include "semap/common/stamp.hpp"
-#include "semap/drivers/clock_offset.hpp"
 #include "semap/firmware_bridge/can_frame.h"
 #include "semap/firmware_bridge/can_imu_decoder.hpp"
 
@@ -41,7 +41,7 @@ class CanSocket {
  private:
   std::string interface_;
   int fd_ = -1;
-  RealtimeToMonotonic clock_;
+  common::ClockOffset clock_;  // socket timestamps are realtime
 };
 
 // True if the interface exists and is administratively up (SIOCGIFFLAGS IFF_UP).

@@ -1,24 +1,27 @@
-#include "semap/drivers/clock_offset.hpp"
+#include "semap/common/clock_offset.hpp"
 
+#include <ctime>
 #include <limits>
 
-namespace semap::drivers {
+namespace semap::common {
 namespace {
 
 std::int64_t read_ns(clockid_t clock) {
   timespec ts{};
   ::clock_gettime(clock, &ts);
-  return common::Stamp::from_timespec(ts).ns;
+  return Stamp::from_timespec(ts).ns;
 }
 
 constexpr int kBrackets = 5;
 
 }  // namespace
 
-RealtimeToMonotonic::RealtimeToMonotonic(std::int64_t refresh_interval_ns)
+ClockOffset::ClockOffset(std::int64_t refresh_interval_ns)
     : refresh_interval_ns_(refresh_interval_ns) {}
 
-void RealtimeToMonotonic::refresh(std::int64_t now_mono) {
+void ClockOffset::refresh_if_due() {
+  const std::int64_t now = read_ns(CLOCK_MONOTONIC);
+  if (valid_ && now - last_refresh_ns_ < refresh_interval_ns_) return;
   std::int64_t best_width = std::numeric_limits<std::int64_t>::max();
   for (int i = 0; i < kBrackets; ++i) {
     const std::int64_t before = read_ns(CLOCK_MONOTONIC);
@@ -30,14 +33,18 @@ void RealtimeToMonotonic::refresh(std::int64_t now_mono) {
     }
   }
   uncertainty_ns_ = best_width / 2;
-  last_refresh_ns_ = now_mono;
+  last_refresh_ns_ = now;
   valid_ = true;
 }
 
-common::Stamp RealtimeToMonotonic::convert(const timespec& realtime) {
-  const std::int64_t now = read_ns(CLOCK_MONOTONIC);
-  if (!valid_ || now - last_refresh_ns_ >= refresh_interval_ns_) refresh(now);
-  return common::Stamp(common::Stamp::from_timespec(realtime).ns - offset_ns_);
+Stamp ClockOffset::to_monotonic(std::int64_t realtime_ns) {
+  refresh_if_due();
+  return Stamp(realtime_ns - offset_ns_);
 }
 
-}  // namespace semap::drivers
+std::int64_t ClockOffset::to_realtime(Stamp monotonic) {
+  refresh_if_due();
+  return monotonic.ns + offset_ns_;
+}
+
+}  // namespace semap::common
