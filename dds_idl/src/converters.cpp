@@ -13,6 +13,9 @@ namespace {
 
 constexpr std::int64_t kNsPerSec = 1'000'000'000;
 
+// A NavSatStatus value as the octet that carries the msg's int8.
+std::uint8_t octet(std::int8_t status) { return static_cast<std::uint8_t>(status); }
+
 void set_header(common::Stamp stamp, const std::string& frame_id, msg::Header& h) {
   h.stamp_ = to_msg_time(stamp);
   h.frame_id_ = const_cast<char*>(frame_id.c_str());  // read only during dds_write
@@ -113,17 +116,17 @@ void to_msg(const common::GnssFix& f, const std::string& frame_id, msg::NavSatFi
   set_header(f.stamp, frame_id, out.header_);
   switch (f.quality) {
     case FixQuality::kInvalid:
-      out.status_.status_ = sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_NO_FIX_;
+      out.status_.status_ = octet(sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_NO_FIX_);
       break;
     case FixQuality::kDgps:
-      out.status_.status_ = sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_SBAS_FIX_;
+      out.status_.status_ = octet(sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_SBAS_FIX_);
       break;
     case FixQuality::kRtkFixed:
     case FixQuality::kRtkFloat:
-      out.status_.status_ = sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_GBAS_FIX_;
+      out.status_.status_ = octet(sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_GBAS_FIX_);
       break;
     default:
-      out.status_.status_ = sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_FIX_;
+      out.status_.status_ = octet(sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_FIX_);
   }
   out.status_.service_ = sensor_msgs_msg_dds__NavSatStatus_Constants_SERVICE_GPS_;
   out.latitude_ = f.latitude_deg;
@@ -168,7 +171,7 @@ common::GnssFix from_msg(const msg::NavSatFix& m) {
   f.longitude_deg = m.longitude_;
   f.altitude_m = m.altitude_;
   f.covariance = get<3>(m.position_covariance_);
-  switch (m.status_.status_) {
+  switch (static_cast<std::int8_t>(m.status_.status_)) {
     case sensor_msgs_msg_dds__NavSatStatus_Constants_STATUS_FIX_:
       f.quality = FixQuality::kGps;
       break;

@@ -14,19 +14,22 @@ struct FieldSpec {
   std::uint32_t offset;
   std::uint8_t datatype;
 };
-constexpr std::array<FieldSpec, 5> kFields{{
+constexpr std::array<FieldSpec, 6> kFields{{
     {0, sensor_msgs_msg_dds__PointField_Constants_FLOAT32_},
     {4, sensor_msgs_msg_dds__PointField_Constants_FLOAT32_},
     {8, sensor_msgs_msg_dds__PointField_Constants_FLOAT32_},
     {12, sensor_msgs_msg_dds__PointField_Constants_FLOAT32_},
-    {16, sensor_msgs_msg_dds__PointField_Constants_UINT16_},
+    {16, sensor_msgs_msg_dds__PointField_Constants_FLOAT32_},
+    {20, sensor_msgs_msg_dds__PointField_Constants_UINT16_},
 }};
+constexpr std::uint32_t kGrey = 0x808080;
 
 static_assert(std::endian::native == std::endian::little, "MapCloud writes little-endian clouds");
 
 }  // namespace
 
-MapCloud::MapCloud(std::string frame_id) : frame_id_(std::move(frame_id)) {
+MapCloud::MapCloud(std::string frame_id, std::vector<std::uint32_t> class_colors)
+    : frame_id_(std::move(frame_id)), class_colors_(std::move(class_colors)) {
   for (std::size_t i = 0; i < fields_.size(); ++i) {
     fields_[i].name_ = names_[i].data();
     fields_[i].offset_ = kFields[i].offset;
@@ -37,9 +40,11 @@ MapCloud::MapCloud(std::string frame_id) : frame_id_(std::move(frame_id)) {
 
 void MapCloud::add(const Eigen::Vector3f& p, std::uint16_t cls, float variance) {
   std::array<std::uint8_t, kPointStep> point{};
+  const std::uint32_t rgb = cls < class_colors_.size() ? class_colors_[cls] & 0xFFFFFF : kGrey;
   std::memcpy(point.data(), p.data(), 12);
-  std::memcpy(point.data() + 12, &variance, 4);
-  std::memcpy(point.data() + 16, &cls, 2);
+  std::memcpy(point.data() + 12, &rgb, 4);
+  std::memcpy(point.data() + 16, &variance, 4);
+  std::memcpy(point.data() + 20, &cls, 2);
   data_.insert(data_.end(), point.begin(), point.end());
 }
 
@@ -67,9 +72,9 @@ const msg::PointCloud2& MapCloud::message(common::Stamp stamp) {
 }
 
 std::vector<CloudPoint> read_map_cloud(const msg::PointCloud2& m) {
-  const std::array<const char*, 5> names{"x", "y", "z", "variance", "class"};
+  const std::array<const char*, 6> names{"x", "y", "z", "rgb", "variance", "class"};
   if (m.fields_._length != names.size()) {
-    throw std::runtime_error("PointCloud2: expected 5 fields, got " +
+    throw std::runtime_error("PointCloud2: expected 6 fields, got " +
                              std::to_string(m.fields_._length));
   }
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -89,8 +94,9 @@ std::vector<CloudPoint> read_map_cloud(const msg::PointCloud2& m) {
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t* p = m.data_._buffer + i * MapCloud::kPointStep;
     std::memcpy(out[i].position.data(), p, 12);
-    std::memcpy(&out[i].variance, p + 12, 4);
-    std::memcpy(&out[i].cls, p + 16, 2);
+    std::memcpy(&out[i].rgb, p + 12, 4);
+    std::memcpy(&out[i].variance, p + 16, 4);
+    std::memcpy(&out[i].cls, p + 20, 2);
   }
   return out;
 }

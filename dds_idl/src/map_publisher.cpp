@@ -45,7 +45,7 @@ MapPublisher::MapPublisher(const Participant& participant, MapPublisherConfig co
       info_writer_(participant, info_topic_, topic_qos(SemapTopic::kMapInfo)),
       cloud_topic_(participant, topic_name(config_.ns, SemapTopic::kMapCloud)),
       cloud_writer_(participant, cloud_topic_, topic_qos(SemapTopic::kMapCloud)),
-      cloud_(config_.frame_id),
+      cloud_(config_.frame_id, description_.class_colors),
       source_(source) {
   if (config_.blocks_hz <= 0.0) throw std::invalid_argument("MapPublisher: blocks_hz must be > 0");
   if (description_.num_classes == 0) {

@@ -29,19 +29,24 @@ std::string_view leaf(SemapTopic topic) {
   throw std::invalid_argument("unknown SemapTopic");
 }
 
+// ROS 2 names: tokens of letters, digits and _ separated by single /, no token starting with a
+// digit, no trailing /.
 void validate_namespace(std::string_view ns) {
-  bool previous_slash = true;
+  bool token_start = true;
   for (char c : ns) {
     const bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '/';
-    if (!ok || (c == '/' && previous_slash)) {
+    if (!ok || (c == '/' && token_start)) {
       throw std::invalid_argument("DDS namespace '" + std::string(ns) +
                                   "' is not a ROS 2 name (letters, digits, _ and single /)");
     }
-    previous_slash = c == '/';
+    if (token_start && std::isdigit(static_cast<unsigned char>(c))) {
+      throw std::invalid_argument("DDS namespace '" + std::string(ns) +
+                                  "': a name token must not start with a digit");
+    }
+    token_start = c == '/';
   }
-  if (!ns.empty() && (ns.back() == '/' || std::isdigit(static_cast<unsigned char>(ns.front())))) {
-    throw std::invalid_argument("DDS namespace '" + std::string(ns) +
-                                "' must not end with / or start with a digit");
+  if (!ns.empty() && ns.back() == '/') {
+    throw std::invalid_argument("DDS namespace '" + std::string(ns) + "' must not end with /");
   }
 }
 
@@ -66,10 +71,10 @@ Qos topic_qos(SemapTopic topic) {
     case SemapTopic::kImu:
       return std::move(Qos().best_effort().keep_last(topic == SemapTopic::kOdometry ? 1 : 10));
     case SemapTopic::kPose:
-    case SemapTopic::kMapCloud:
       return std::move(Qos().reliable().keep_last(1));
     case SemapTopic::kMapBlocks:
     case SemapTopic::kMapInfo:
+    case SemapTopic::kMapCloud:  // the whole map: a late joiner gets the current one
       // Late joiners get the current version of every block from the writer's history.
       return std::move(Qos().reliable().transient_local().keep_last(1));
     case SemapTopic::kHealth:

@@ -3,6 +3,9 @@
 // DCPSPublication topic, which is where a ROS 2 node using rmw_cyclonedds_cpp learns about
 // them too. Each topic and type name must be exactly the one rosidl/rmw would use, and the
 // reliability and durability (the QoS that decide matching) those documented in docs/dds.md.
+// rmw_cyclonedds creates every reader keyless, and Cyclone matches a keyless reader only with a
+// keyless writer: every topic a ROS 2 node reads must come from a keyless writer (the entity
+// kind in the writer's GUID says which); only map_blocks, for DDS-native clients, is keyed.
 #include <dds/dds.h>
 #include <gtest/gtest.h>
 
@@ -24,6 +27,7 @@ struct Announced {
   bool has_history = false;
   dds_history_kind_t history = DDS_HISTORY_KEEP_LAST;
   std::int32_t depth = 0;
+  bool keyed = false;
 };
 
 struct Expected {
@@ -33,6 +37,7 @@ struct Expected {
   dds_reliability_kind_t reliability;
   dds_durability_kind_t durability;
   std::int32_t depth;
+  bool keyed = false;
 };
 
 const std::vector<Expected>& expected_topics() {
@@ -47,9 +52,9 @@ const std::vector<Expected>& expected_topics() {
       {"imu", "sensor_msgs::msg::dds_::Imu_", "sensor_msgs/msg/Imu", DDS_RELIABILITY_BEST_EFFORT,
        DDS_DURABILITY_VOLATILE, 10},
       {"map_cloud", "sensor_msgs::msg::dds_::PointCloud2_", "sensor_msgs/msg/PointCloud2",
-       DDS_RELIABILITY_RELIABLE, DDS_DURABILITY_VOLATILE, 1},
-      {"map_blocks", "semap_msgs::msg::dds_::SemanticMapBlock_", "semap_msgs/msg/SemanticMapBlock",
        DDS_RELIABILITY_RELIABLE, DDS_DURABILITY_TRANSIENT_LOCAL, 1},
+      {"map_blocks", "semap_msgs::msg::dds_::SemanticMapBlock_", "semap_msgs/msg/SemanticMapBlock",
+       DDS_RELIABILITY_RELIABLE, DDS_DURABILITY_TRANSIENT_LOCAL, 1, true},
       {"map_info", "semap_msgs::msg::dds_::MapInfo_", "semap_msgs/msg/MapInfo",
        DDS_RELIABILITY_RELIABLE, DDS_DURABILITY_TRANSIENT_LOCAL, 1},
       {"health", "semap_msgs::msg::dds_::Health_", "semap_msgs/msg/Health",
@@ -98,6 +103,8 @@ std::map<std::string, Announced> discovered_publications(const Participant& part
       dds_qget_reliability(ep->qos, &a.reliability, &blocking);
       dds_qget_durability(ep->qos, &a.durability);
       a.has_history = dds_qget_history(ep->qos, &a.history, &a.depth);
+      // RTPS entity kinds: 0x02 user writer with key, 0x03 without.
+      a.keyed = ep->key.v[15] == 0x02;
       out[topic] = a;
     }
     if (n > 0) dds_return_loan(reader.handle(), samples, n);
@@ -130,6 +137,7 @@ TEST_F(DdsTest, WritersAnnounceRos2TopicAndTypeNames) {
     EXPECT_EQ(ros_type(a.type), e.ros_type);
     EXPECT_EQ(a.reliability, e.reliability);
     EXPECT_EQ(a.durability, e.durability);
+    EXPECT_EQ(a.keyed, e.keyed) << "a keyed writer never matches rmw_cyclonedds' keyless readers";
     // Cyclone announces the history too (not an RxO policy, but the documented depth).
     ASSERT_TRUE(a.has_history);
     EXPECT_EQ(a.history, DDS_HISTORY_KEEP_LAST);

@@ -167,7 +167,7 @@ TEST(BlockGeometry, PointsMapToTheCellWhoseCentreTheyAreNear) {
 }
 
 TEST(MapCloud, ReadsBackWhatItWrote) {
-  MapCloud cloud("map");
+  MapCloud cloud("map", {0x000000, 0x804080});
   const BlockSnapshot b = sample_block(false);
   cloud.add_occupied(b);
   const auto points = read_map_cloud(cloud.message(common::Stamp(5)));
@@ -178,6 +178,9 @@ TEST(MapCloud, ReadsBackWhatItWrote) {
     EXPECT_TRUE(points[occupied].position.isApprox(b.cell_center(i)));
     EXPECT_EQ(points[occupied].cls, b.argmax_class[i]);
     EXPECT_EQ(points[occupied].variance, b.variance[i]);
+    // Classes 0 and 1 have palette colours, class 2 is beyond the palette: grey.
+    const std::uint32_t rgb[] = {0x000000, 0x804080, 0x808080};
+    EXPECT_EQ(points[occupied].rgb, rgb[b.argmax_class[i]]);
     ++occupied;
   }
   EXPECT_EQ(points.size(), occupied);

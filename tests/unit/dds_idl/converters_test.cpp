@@ -77,7 +77,8 @@ TEST(Converters, NavSatFixStatusAndCovariance) {
         std::pair{common::FixQuality::kDgps, 1}, std::pair{common::FixQuality::kRtkFloat, 2}}) {
     f.quality = q;
     to_msg(f, frame, m);
-    EXPECT_EQ(m.status_.status_, status);
+    EXPECT_EQ(static_cast<std::int8_t>(m.status_.status_), status);  // int8 in an octet
+    EXPECT_EQ(from_msg(m).quality == common::FixQuality::kInvalid, status == -1);
   }
   EXPECT_EQ(m.position_covariance_[1], 2.0);  // row-major
   EXPECT_EQ(m.position_covariance_[3], 4.0);

@@ -9,7 +9,8 @@ TEST(TopicNames, FollowRosTwoMapping) {
   EXPECT_EQ(topic_name("", SemapTopic::kOdometry), "rt/semap/odometry");
   EXPECT_EQ(topic_name("robot1", SemapTopic::kMapBlocks), "rt/robot1/semap/map_blocks");
   EXPECT_EQ(topic_name("fleet/robot_2", SemapTopic::kMapCloud), "rt/fleet/robot_2/semap/map_cloud");
-  for (const char* bad : {"/robot", "robot/", "a//b", "1robot", "ro-bot", "ro bot"}) {
+  for (const char* bad :
+       {"/robot", "robot/", "a//b", "1robot", "fleet/2", "a/2b", "ro-bot", "ro bot"}) {
     EXPECT_THROW(topic_name(bad, SemapTopic::kPose), std::invalid_argument) << bad;
   }
 }

@@ -12,13 +12,17 @@
 
 namespace semap::dds_idl {
 
-// Occupied cells as sensor_msgs/PointCloud2 for RViz: fields x, y, z, variance (float32) and
-// class (uint16), little endian, 20 bytes a point, one row.
+// Occupied cells as sensor_msgs/PointCloud2 for RViz and any ROS 2 node: fields x, y, z
+// (float32), rgb (float32 holding 0x00RRGGBB, PCL's packing, which RViz colours by), variance
+// (float32, of the class probability) and class (uint16), little endian, 24 bytes a point
+// (2 bytes of padding), one row.
 class MapCloud {
  public:
-  static constexpr std::uint32_t kPointStep = 20;
+  static constexpr std::uint32_t kPointStep = 24;
 
-  explicit MapCloud(std::string frame_id);
+  // `class_colors`: 0xRRGGBB per class (MapDescription::class_colors); classes beyond it are
+  // grey.
+  MapCloud(std::string frame_id, std::vector<std::uint32_t> class_colors);
   MapCloud(const MapCloud&) = delete;
   MapCloud& operator=(const MapCloud&) = delete;
 
@@ -32,8 +36,9 @@ class MapCloud {
 
  private:
   std::string frame_id_;
-  std::array<std::string, 5> names_{"x", "y", "z", "variance", "class"};
-  std::array<msg::PointField, 5> fields_{};
+  std::vector<std::uint32_t> class_colors_;
+  std::array<std::string, 6> names_{"x", "y", "z", "rgb", "variance", "class"};
+  std::array<msg::PointField, 6> fields_{};
   std::vector<std::uint8_t> data_;
   msg::PointCloud2 msg_{};
 };
@@ -42,6 +47,7 @@ struct CloudPoint {
   Eigen::Vector3f position;
   std::uint16_t cls = 0;
   float variance = 0.0f;
+  std::uint32_t rgb = 0;  // 0x00RRGGBB
 };
 
 // Reads a cloud written by MapCloud; throws std::runtime_error naming the field when the
