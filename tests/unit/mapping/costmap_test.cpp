@@ -258,19 +258,20 @@ TEST(Costmap, CoarserCostmapAggregatesTheMapColumnsWhoseCentreFallsInACell) {
 }
 
 TEST(Costmap, CellsOfUnalignedResolutionsGoWhereTheirCentreIs) {
-  // Map 0.2 m, costmap 0.3 m: columns centred at x 0.1, 0.3, 0.5, 0.7 fall in costmap cells
-  // 0, 1, 1, 2 (cells [0, 0.3), [0.3, 0.6), [0.6, 0.9)).
+  // Map 0.2 m, costmap 0.3 m: columns [0, 0.2), [0.2, 0.4), [0.4, 0.6), [0.6, 0.8) have their
+  // centre in costmap cells 0, 1, 1, 2 ([0, 0.3), [0.3, 0.6), [0.6, 0.9)); the second column
+  // overlaps cell 0 too, but belongs to cell 1 only.
   auto map = Scene()
-                 .add(0.1f, 0.1f, 0.1f, kCar)
-                 .add(0.3f, 0.1f, 0.1f, kRoad)
+                 .add(0.1f, 0.1f, 0.1f, kRoad)
+                 .add(0.3f, 0.1f, 0.1f, kVegetation)
                  .add(0.5f, 0.1f, 0.1f, kTerrain)
                  .add(0.7f, 0.1f, 0.1f, kSidewalk)
                  .map();
   CostmapParams p = street_costs();
   p.resolution = 0.3;
   const Costmap costmap = build_costmap(map, p, kCentre);
-  EXPECT_EQ(cost_at(costmap, 0.15, 0.15), 100);
-  EXPECT_EQ(cost_at(costmap, 0.45, 0.15), 40);
+  EXPECT_EQ(cost_at(costmap, 0.15, 0.15), 0);
+  EXPECT_EQ(cost_at(costmap, 0.45, 0.15), 70);
   EXPECT_EQ(cost_at(costmap, 0.75, 0.15), 0);
 }
 
