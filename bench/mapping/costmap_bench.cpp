@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -124,6 +125,11 @@ void BM_UpdateCostmapAfterInsert(benchmark::State& state) {
     blocks += static_cast<double>(result.updated_blocks.size());
     changed_cells += static_cast<double>(update.data.size());
   }
+  // A full build of the same window on the final map, for comparison.
+  const auto start = std::chrono::steady_clock::now();
+  benchmark::DoNotOptimize(build_costmap(*s.map, p, s.robot).data.data());
+  state.counters["full_build_ms"] =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   report_map(state, costmap);
   state.counters["blocks_per_insert"] = blocks / static_cast<double>(state.iterations());
   state.counters["update_cells"] = changed_cells / static_cast<double>(state.iterations());
