@@ -36,16 +36,30 @@ void shear_columns(PaddedBlock9& m, const Vector3d& g, double t) {
   }
 }
 
-// Column c of y += hq h.row(c)^T + n n.row(c)^T over the first Rows rows (and Ranks columns
-// of h).
+// Column c of y += n n.row(c)^T + hq h.row(c)^T over its first Rows rows (and the first
+// Ranks columns of h), as one chain of FMAs on whole packets per packet of rows (a lazy
+// product per term would cost a multiply and an add more per packet).
 template <int Rows, int Ranks>
-void add_outer_column(PaddedBlock9& y, const PaddedBlock6& hq, const PaddedBlock6& h,
-                      const GyroNoiseFactor& n, int c) {
-  // Lazy products, so that Eigen uses FMA packets.
-  y.col(c).template head<Rows>().noalias() += hq.template topLeftCorner<Rows, Ranks>().lazyProduct(
-      h.template block<1, Ranks>(c, 0).transpose());
-  y.col(c).template head<Rows>().noalias() +=
-      n.template topRows<Rows>().lazyProduct(n.row(c).transpose());
+void add_outer_column(PaddedBlock9& y, const GyroNoiseFactor& n, const PaddedBlock6& hq,
+                      const PaddedBlock6& h, int c) {
+  Eigen::Matrix<double, Rows, 1> acc = y.col(c).template head<Rows>();
+  for (int k = 0; k < 3; ++k) acc += n.col(k).template head<Rows>() * n(c, k);
+  for (int k = 0; k < Ranks; ++k) acc += hq.col(k).template head<Rows>() * h(c, k);
+  y.col(c).template head<Rows>() = acc;
+}
+
+// a.block<3, 3>(row, col) += sign S for the symmetric S in row `power` of the accel sums (see
+// the header).
+void add_accel_sum(PaddedBlock9& a, const Eigen::Matrix<double, 4, 6>& sums, int power, int row,
+                   int col, double sign) {
+  int e = 0;
+  for (int j = 0; j < 3; ++j) {
+    a(row + j, col + j) += sign * sums(power, e++);
+    for (int i = j + 1; i < 3; ++i, ++e) {
+      a(row + i, col + j) += sign * sums(power, e);
+      a(row + j, col + i) += sign * sums(power, e);
+    }
+  }
 }
 
 }  // namespace
@@ -86,9 +100,15 @@ void CovarianceWindow::clear() {
 
 void CovarianceWindow::add(const InekfImuStep& step, const Matrix3d& r) {
   const double dt = step.dt;
-  const double root_dt = std::sqrt(dt);
+  if (dt != scaled_dt_) {
+    scaled_dt_ = dt;
+    const double root_dt = std::sqrt(dt);
+    gyro_scale_ = root_dt * gyro_sigma_;
+    accel_scale_ = root_dt * accel_sigma_;
+    bias_weights_ = qb_ * dt;
+  }
   // The gyro columns of N_k, padded like H.
-  const Matrix3d rg = r * (root_dt * gyro_sigma_).asDiagonal();
+  const Matrix3d rg = r * gyro_scale_.asDiagonal();
   GyroNoiseFactor n;
   n.block<3, 3>(kRot, 0) = rg;
   for (int j = 0; j < 3; ++j) {
@@ -97,21 +117,23 @@ void CovarianceWindow::add(const InekfImuStep& step, const Matrix3d& r) {
   }
   n.bottomRows<kPaddedRows - 9>().setZero();
   // Its accel columns [0; Ra; -t_k Ra] only need the sums of Sa, t_k Sa and t_k^2 Sa,
-  // Sa = Ra Ra^T (3x3 each, instead of a rank-3 update of the velocity and position columns).
-  const Matrix3d ra = r * (root_dt * accel_sigma_).asDiagonal();
-  Matrix3d sa;
-  sa.noalias() = ra * ra.transpose();
-  accel_sums_.leftCols<3>() += sa;
-  accel_sums_.middleCols<3>(3) += step.t0 * sa;
-  accel_sums_.rightCols<3>() += (step.t0 * step.t0) * sa;
-  // Y += H Qb H^T dt + N N^T on the upper block triangle (mirrored in apply): columns of block
-  // b take rows 0..3b+2 rounded up to whole packets. Rotation rows have no accel-bias part.
-  const Eigen::Matrix<double, 6, 1> weights = qb_ * dt;
-  const PaddedBlock6 hq = h_ * weights.asDiagonal();
+  // Sa = Ra Ra^T (instead of a rank-3 update of the velocity and position columns): each of
+  // the 6 entries of the symmetric Sa adds to its three sums in one packet.
+  const Matrix3d ra = r * accel_scale_.asDiagonal();
+  const Eigen::Vector4d powers(1.0, step.t0, step.t0 * step.t0, 0.0);
+  int e = 0;
+  for (int j = 0; j < 3; ++j) {
+    for (int i = j; i < 3; ++i) accel_sums_.col(e++) += ra.row(i).dot(ra.row(j)) * powers;
+  }
+  // Y += H Qb H^T dt + N N^T on the upper triangle (mirrored in apply): column c takes rows
+  // 0..c rounded up to whole packets (4, 4, 4, 4, 8, 8, 8, 8, 12 rows). The rotation columns
+  // have no accel-bias part (H has no rotation rows there).
+  const PaddedBlock6 hq = h_ * bias_weights_.asDiagonal();
   kq_ += hq;
-  for (int c = kRot; c < kRot + 3; ++c) add_outer_column<4, 3>(y_, hq, h_, n, c);
-  for (int c = kVel; c < kVel + 3; ++c) add_outer_column<8, 6>(y_, hq, h_, n, c);
-  for (int c = kPos; c < kPos + 3; ++c) add_outer_column<kPaddedRows, 6>(y_, hq, h_, n, c);
+  for (int c = kRot; c < kRot + 3; ++c) add_outer_column<4, 3>(y_, n, hq, h_, c);
+  add_outer_column<4, 6>(y_, n, hq, h_, kVel);
+  for (int c = kVel + 1; c < kPos + 2; ++c) add_outer_column<8, 6>(y_, n, hq, h_, c);
+  add_outer_column<kPaddedRows, 6>(y_, n, hq, h_, kPos + 2);
   h_ += step.coupling;
   elapsed_ += dt;
   ++steps_;
@@ -131,18 +153,18 @@ void CovarianceWindow::apply(WorldCovariance& p) const {
   // A0 + W H^T + H W^T as two lazy products (FMA packets; a transposed add is scalar code).
   p.a.noalias() += w.lazyProduct(h_.topRows<9>().transpose());
   p.a.noalias() += h_.lazyProduct(w.topRows<9>().transpose());
-  // + Y: add_outer_column filled its upper block triangle rounded up to whole packets (rows
-  // 0-3 of the rotation columns, 0-7 of the velocity columns); mirror the rest.
+  // + Y: add_outer_column filled its upper triangle rounded up to whole packets; mirror the
+  // rest.
   p.a += y_;
-  for (int c = kRot; c < kRot + 3; ++c) {
+  for (int c = 0; c < 4; ++c) {
     for (int r = 4; r < 9; ++r) p.a(r, c) += y_(c, r);
   }
-  for (int c = kVel; c < kVel + 3; ++c) p.a(8, c) += y_(c, 8);
+  for (int c = 4; c < 8; ++c) p.a(8, c) += y_(c, 8);
   // The accel columns of N N^T, [0, 0, 0; 0, Sa, -t_k Sa; 0, -t_k Sa, t_k^2 Sa], summed.
-  p.a.block<3, 3>(kVel, kVel) += accel_sums_.leftCols<3>();
-  p.a.block<3, 3>(kPos, kVel) -= accel_sums_.middleCols<3>(3);
-  p.a.block<3, 3>(kVel, kPos) -= accel_sums_.middleCols<3>(3);
-  p.a.block<3, 3>(kPos, kPos) += accel_sums_.rightCols<3>();
+  add_accel_sum(p.a, accel_sums_, 0, kVel, kVel, 1.0);
+  add_accel_sum(p.a, accel_sums_, 1, kPos, kVel, -1.0);
+  add_accel_sum(p.a, accel_sums_, 1, kVel, kPos, -1.0);
+  add_accel_sum(p.a, accel_sums_, 2, kPos, kPos, 1.0);
   shear_rows(p.a, gravity_, t);
   shear_columns(p.a, gravity_, t);
   // The position noise, isotropic and on the position block only, is left alone by F.

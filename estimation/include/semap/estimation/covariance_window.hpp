@@ -42,10 +42,10 @@ using GyroNoiseFactor = Eigen::Matrix<double, kPaddedRows, 3>;
 // The IMU noise is diagonal in the body frame, so its world form R D^2 R^T changes with the
 // rotation of every step and has to be summed per step, exactly; only the isotropic position
 // noise commutes with all of it. Per step that is a coupling sum, rank-6 (bias walk) and
-// rank-3 (gyro noise) updates of Y on its upper block triangle (the accel-bias columns of H
-// have no rotation rows), and for the accel noise, whose columns of N_k are [0; I; -t_k I] Ra
-// with Ra = R Da sqrt(dt_k), the sums of Sa, t_k Sa and t_k^2 Sa for Sa = Ra Ra^T; instead of
-// the two 12x6 by 6x9 products, the shears and the noise of a per-step propagation.
+// rank-3 (gyro noise) updates of Y on its upper triangle (the accel-bias columns of H have no
+// rotation rows), and for the accel noise, whose columns of N_k are [0; I; -t_k I] Ra with
+// Ra = R Da sqrt(dt_k), the sums of Sa, t_k Sa and t_k^2 Sa for Sa = Ra Ra^T; instead of the
+// two 12x6 by 6x9 products, the shears and the noise of a per-step propagation.
 class CovarianceWindow {
  public:
   CovarianceWindow(const ImuNoise& noise, const Eigen::Vector3d& gravity);
@@ -67,11 +67,19 @@ class CovarianceWindow {
   Eigen::Matrix<double, 6, 1> qb_;            // bias random-walk densities squared
   int steps_ = 0;
   double elapsed_ = 0.0;
+  // The per-step scales of the noise for steps of length scaled_dt_: IMUs run at a fixed rate,
+  // so they are computed (with a square root) only when dt changes, not per step.
+  double scaled_dt_ = 0.0;
+  Eigen::Vector3d gyro_scale_ = Eigen::Vector3d::Zero();   // gyro_sigma_ sqrt(dt)
+  Eigen::Vector3d accel_scale_ = Eigen::Vector3d::Zero();  // accel_sigma_ sqrt(dt)
+  Eigen::Matrix<double, 6, 1> bias_weights_ = Eigen::Matrix<double, 6, 1>::Zero();  // Qb dt
   PaddedBlock6 h_ = PaddedBlock6::Zero();
   PaddedBlock6 kq_ = PaddedBlock6::Zero();  // K Qb
-  PaddedBlock9 y_ = PaddedBlock9::Zero();
-  // Sums of Sa, t_k Sa and t_k^2 Sa for the accel noise (Sa = R Da^2 R^T dt_k).
-  Eigen::Matrix<double, 3, 9> accel_sums_ = Eigen::Matrix<double, 3, 9>::Zero();
+  PaddedBlock9 y_ = PaddedBlock9::Zero();   // upper triangle, see add_outer_column
+  // Sums of Sa, t_k Sa and t_k^2 Sa for the accel noise (Sa = R Da^2 R^T dt_k): rows 0-2, for
+  // the 6 entries of the symmetric Sa in columns (00, 10, 20, 11, 21, 22); row 3 pads the
+  // column to a whole AVX packet, so that a step adds to all three sums at once.
+  Eigen::Matrix<double, 4, 6> accel_sums_ = Eigen::Matrix<double, 4, 6>::Zero();
 };
 
 }  // namespace semap::estimation
