@@ -8,7 +8,8 @@
 namespace semap::onboard {
 
 DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& map,
-                       const dds_idl::BlockSource& map_blocks)
+                       const dds_idl::BlockSource& map_blocks,
+                       const std::optional<CostmapConfig>& costmap, const CostmapSource* costmaps)
     : config_(config),
       participant_(static_cast<dds_domainid_t>(config.domain)),
       odometry_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kOdometry),
@@ -23,6 +24,9 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
                                                  config.cloud_hz},
                      map, map_blocks) {
   dds_idl::set_stamp_clock(config.stamp_clock);
+  if (costmap && costmaps != nullptr) {
+    costmap_.emplace(participant_, config.ns, config.frame_id, *costmap, *costmaps);
+  }
 }
 
 // Only joins: the map view may be gone by now (stop() is what publishes the last changes).
@@ -52,6 +56,10 @@ void DdsOutputs::take_changed() {
     changed.swap(changed_);
   }
   for (const auto& index : changed) map_publisher_.changed(index);
+  if (costmap_) {
+    const std::vector<common::BlockIndex> blocks(changed.begin(), changed.end());
+    costmap_->changed(blocks);
+  }
 }
 
 void DdsOutputs::update_counters() {
@@ -64,13 +72,26 @@ void DdsOutputs::run_publisher(std::stop_token stop) {
   constexpr auto kTick = std::chrono::milliseconds(20);
   while (!stop.stop_requested()) {
     take_changed();
-    map_publisher_.spin_once(common::Stamp::now());
+    const common::Stamp now = common::Stamp::now();
+    map_publisher_.spin_once(now);
+    if (costmap_) {
+      std::optional<Eigen::Vector2d> robot;
+      {
+        std::lock_guard lock(robot_mutex_);
+        robot = robot_;
+      }
+      costmap_->spin_once(now, robot);
+    }
     update_counters();
     std::this_thread::sleep_for(kTick);
   }
 }
 
 void DdsOutputs::publish_pose(const PoseOutput& pose) {
+  if (costmap_) {
+    std::lock_guard lock(robot_mutex_);
+    robot_ = pose.pose.position.head<2>();
+  }
   dds_idl::PoseEstimate p;
   p.stamp = pose.pose.stamp;
   p.position = pose.pose.position;

@@ -26,8 +26,12 @@ namespace semap::onboard {
 class DdsOutputs {
  public:
   // `map_blocks` (the mapping stage's view) outlives the publisher thread: stop() first.
+  // With `costmap`, also the costmap around the robot, read from `costmaps` (which outlives
+  // the publisher thread too).
   DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& map,
-             const dds_idl::BlockSource& map_blocks);
+             const dds_idl::BlockSource& map_blocks,
+             const std::optional<CostmapConfig>& costmap = std::nullopt,
+             const CostmapSource* costmaps = nullptr);
   ~DdsOutputs();
 
   // The map publisher's thread; stop() publishes what changed last before it returns.
@@ -43,6 +47,10 @@ class DdsOutputs {
   std::uint64_t odometry_written() const { return odometry_written_.load(); }
   std::uint64_t health_written() const { return health_written_; }
   dds_idl::MapPublisherCounters map_counters() const;
+  // After stop(): what the costmap output wrote (nullopt without a costmap).
+  std::optional<CostmapOutput::Counters> costmap_counters() const {
+    return costmap_ ? std::optional(costmap_->counters()) : std::nullopt;
+  }
   // Changed blocks waiting for the next publication round.
   std::size_t map_pending() const;
 
@@ -58,7 +66,10 @@ class DdsOutputs {
   void take_changed();
   void update_counters();
 
-  dds_idl::MapPublisher map_publisher_;  // the publisher thread's
+  dds_idl::MapPublisher map_publisher_;   // the publisher thread's
+  std::optional<CostmapOutput> costmap_;  // the publisher thread's
+  mutable std::mutex robot_mutex_;
+  std::optional<Eigen::Vector2d> robot_;  // from the latest pose
   std::mutex changed_mutex_;
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
   std::uint64_t health_written_ = 0;  // main thread only

@@ -220,7 +220,8 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   // mapping thread starts).
   if (config.dds.enabled)
     dds = std::make_unique<onboard::DdsOutputs>(config.dds, onboard::describe_map(config.map),
-                                                mapping_stage.blocks());
+                                                mapping_stage.blocks(), config.costmap,
+                                                &mapping_stage.costmaps());
   // A resumed map lives in the frame it was built in: the estimator anchors there too.
   onboard::EstimationStageConfig estimation_config{
       config.estimator, config.map.start_heading_sigma_deg, config.dds.odometry_hz};
@@ -401,6 +402,12 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
         "%lu map clouds, %lu health reports\n",
         dds->odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
         dds->health_written());
+    if (const auto c = dds->costmap_counters()) {
+      std::printf(
+          "costmap          : %lu grids (%lu rebuilt around the robot), %lu updates, last round "
+          "%.1f ms\n",
+          c->grids_written, c->rebuilds, c->updates_written, 1e3 * c->last_seconds);
+    }
   }
   std::printf("ring drops       : imu %lu, gnss %lu, colour %lu, depth %lu, clouds %lu\n",
               drops(imu_ring), drops(gnss_ring), drops(colour_ring), drops(depth_ring),

@@ -187,4 +187,17 @@ bool MappingStage::read(const common::BlockIndex& index, dds_idl::BlockSnapshot&
   return true;
 }
 
+mapping::Costmap MappingStage::build_costmap(const mapping::CostmapParams& p,
+                                             const Eigen::Vector2d& centre) const {
+  std::shared_lock lock(map_mutex_);
+  return mapping::build_costmap(map_, p, centre);
+}
+
+mapping::CostmapUpdate MappingStage::update_costmap(
+    mapping::Costmap& costmap, const mapping::CostmapParams& p,
+    std::span<const common::BlockIndex> changed) const {
+  std::shared_lock lock(map_mutex_);
+  return mapping::update_costmap(costmap, map_, p, changed);
+}
+
 }  // namespace semap::onboard

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "costmap_output.hpp"
 #include "latency_window.hpp"
 #include "onboard_config.hpp"
 #include "semap/common/messages.hpp"
@@ -38,7 +39,7 @@ struct MappingStageStats {
 // thread and at its own rate, through blocks(): a read-only view of the map that shares a
 // lock with the inserts, so the map is held once. With a checkpoint path the stage keeps the
 // map recoverable (MapCheckpoint) and, with a memory radius, bounded (MapPager).
-class MappingStage : private dds_idl::BlockSource {
+class MappingStage : private dds_idl::BlockSource, private CostmapSource {
  public:
   // Called on the mapping thread; must not block.
   using BlockSink = std::function<void(const std::vector<common::BlockIndex>&)>;
@@ -59,6 +60,8 @@ class MappingStage : private dds_idl::BlockSource {
   // The map's blocks as the publisher sends them; safe from any thread. A paged-out block is
   // read from the checkpoint log; for_each_block lists the blocks in memory.
   const dds_idl::BlockSource& blocks() const { return *this; }
+  // The costmap of the map's blocks in memory, for the publisher's thread; safe from any thread.
+  const CostmapSource& costmaps() const { return *this; }
   // Only after stop(): the map belongs to the stage thread while it runs. With a memory
   // radius, the whole map read back from the checkpoint log, else the map itself.
   const mapping::SemanticMap& map();
@@ -77,6 +80,11 @@ class MappingStage : private dds_idl::BlockSource {
   // BlockSource, for the publisher's thread.
   void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const override;
   bool read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
+  // CostmapSource, for the publisher's thread.
+  mapping::Costmap build_costmap(const mapping::CostmapParams& p,
+                                 const Eigen::Vector2d& centre) const override;
+  mapping::CostmapUpdate update_costmap(mapping::Costmap& costmap, const mapping::CostmapParams& p,
+                                        std::span<const common::BlockIndex> changed) const override;
 
   const MappingConfig& config_;
   common::SpscRing<common::LabeledCloud>& clouds_;

@@ -220,6 +220,14 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   map.finish();
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);
+  if (root.has("costmap")) {
+    const auto costmap = root.section("costmap");
+    CostmapConfig cc;
+    cc.params = mapping::costmap_params_from_config(costmap, c.map.palette);
+    cc.publish_hz = costmap.get_in_range("publish_hz", cc.publish_hz, 0.1, 50.0);
+    costmap.finish();
+    c.costmap = cc;
+  }
   root.finish();
   if (c.rig.simulated && c.depth.source != DepthSource::kAligned) {
     throw common::ConfigError(path.string() +

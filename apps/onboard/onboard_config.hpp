@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "costmap_output.hpp"
 #include "perception_config.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
@@ -96,6 +97,7 @@ struct OnboardConfig {
   SegmenterConfig segmenter;
   estimation::EstimatorConfig estimator;
   MappingConfig map;
+  std::optional<CostmapConfig> costmap;  // the `costmap:` section; published over DDS
   DdsConfig dds;
   std::string log_level = "info";
 };

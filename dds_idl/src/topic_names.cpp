@@ -25,6 +25,10 @@ std::string_view leaf(SemapTopic topic) {
       return "map_cloud";
     case SemapTopic::kHealth:
       return "health";
+    case SemapTopic::kCostmap:
+      return "costmap";
+    case SemapTopic::kCostmapUpdates:
+      return "costmap_updates";
   }
   throw std::invalid_argument("unknown SemapTopic");
 }
@@ -75,9 +79,11 @@ Qos topic_qos(SemapTopic topic) {
     case SemapTopic::kMapBlocks:
     case SemapTopic::kMapInfo:
     case SemapTopic::kMapCloud:  // the whole map: a late joiner gets the current one
+    case SemapTopic::kCostmap:   // as nav2's static layer subscribes to `map`
       // Late joiners get the current version of every block from the writer's history.
       return std::move(Qos().reliable().transient_local().keep_last(1));
     case SemapTopic::kHealth:
+    case SemapTopic::kCostmapUpdates:
       return std::move(Qos().reliable().keep_last(10));
   }
   throw std::invalid_argument("unknown SemapTopic");

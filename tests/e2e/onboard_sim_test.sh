@@ -112,6 +112,10 @@ at_least "$agreement" 0.99 || fail "received map vs saved map: $(tr '\n' ' ' <"$
 
 # The robot's health, as before the report existed.
 grep -q "gated out), initialised=yes" "$work/onboard.log" || fail "not initialised"
+# The costmap for nav2 went out, rebuilt around the robot as it drove and updated between.
+costmap=$(grep '^costmap ' "$work/onboard.log" || true)
+grids=$(awk '{print $3}' <<<"$costmap")
+[[ -n "$grids" && "$grids" -ge 5 ]] || fail "costmap: '$costmap'"
 scans=$(sed -n 's/^mapping *: \([0-9]*\) scans.*/\1/p' "$work/onboard.log")
 posed=$(sed -n 's/^perception *: [0-9]* frames, \([0-9]*\) clouds mapped.*/\1/p' "$work/onboard.log")
 [[ -n "$posed" && "$posed" -eq "$mapped" ]] || fail "perception: $posed clouds, report: $mapped"

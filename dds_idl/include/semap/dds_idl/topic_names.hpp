@@ -8,7 +8,18 @@
 namespace semap::dds_idl {
 
 // The topics semap publishes, named as ROS 2 maps `/<ns>/semap/<leaf>` onto DDS.
-enum class SemapTopic { kOdometry, kPose, kGnss, kImu, kMapBlocks, kMapInfo, kMapCloud, kHealth };
+enum class SemapTopic {
+  kOdometry,
+  kPose,
+  kGnss,
+  kImu,
+  kMapBlocks,
+  kMapInfo,
+  kMapCloud,
+  kHealth,
+  kCostmap,
+  kCostmapUpdates
+};
 
 // "rt/semap/odometry" for an empty namespace, "rt/robot1/semap/odometry" for "robot1".
 // Throws std::invalid_argument for a namespace that is not a valid ROS 2 name.

@@ -4,6 +4,8 @@
 // the C struct as parameter.
 #include <builtin_interfaces/msg/Time_.h>
 #include <geometry_msgs/msg/PoseWithCovarianceStamped_.h>
+#include <map_msgs/msg/OccupancyGridUpdate_.h>
+#include <nav_msgs/msg/OccupancyGrid_.h>
 #include <nav_msgs/msg/Odometry_.h>
 #include <semap_msgs/msg/Health_.h>
 #include <semap_msgs/msg/MapInfo_.h>
@@ -19,6 +21,8 @@ using Time = builtin_interfaces_msg_dds__Time_;
 using Header = std_msgs_msg_dds__Header_;
 using PoseWithCovarianceStamped = geometry_msgs_msg_dds__PoseWithCovarianceStamped_;
 using Odometry = nav_msgs_msg_dds__Odometry_;
+using OccupancyGrid = nav_msgs_msg_dds__OccupancyGrid_;
+using OccupancyGridUpdate = map_msgs_msg_dds__OccupancyGridUpdate_;
 using Imu = sensor_msgs_msg_dds__Imu_;
 using NavSatFix = sensor_msgs_msg_dds__NavSatFix_;
 using PointField = sensor_msgs_msg_dds__PointField_;
@@ -48,6 +52,8 @@ SEMAP_DDS_TYPE(msg::PointCloud2, sensor_msgs_msg_dds__PointCloud2__desc);
 SEMAP_DDS_TYPE(msg::SemanticMapBlock, semap_msgs_msg_dds__SemanticMapBlock__desc);
 SEMAP_DDS_TYPE(msg::MapInfo, semap_msgs_msg_dds__MapInfo__desc);
 SEMAP_DDS_TYPE(msg::Health, semap_msgs_msg_dds__Health__desc);
+SEMAP_DDS_TYPE(msg::OccupancyGrid, nav_msgs_msg_dds__OccupancyGrid__desc);
+SEMAP_DDS_TYPE(msg::OccupancyGridUpdate, map_msgs_msg_dds__OccupancyGridUpdate__desc);
 
 #undef SEMAP_DDS_TYPE
 
