@@ -9,6 +9,7 @@ namespace semap::onboard {
 
 DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& map,
                        const dds_idl::BlockSource& map_blocks,
+                       const std::vector<SensorFrame>& sensor_frames,
                        const std::optional<CostmapConfig>& costmap, const CostmapSource* costmaps)
     : config_(config),
       participant_(static_cast<dds_domainid_t>(config.domain)),
@@ -16,6 +17,13 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
                       dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
       odometry_writer_(participant_, odometry_topic_,
                        dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
+      tf_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kTf),
+                dds_idl::topic_qos(dds_idl::SemapTopic::kTf)),
+      tf_writer_(participant_, tf_topic_, dds_idl::topic_qos(dds_idl::SemapTopic::kTf)),
+      tf_static_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kTfStatic),
+                       dds_idl::topic_qos(dds_idl::SemapTopic::kTfStatic)),
+      tf_static_writer_(participant_, tf_static_topic_,
+                        dds_idl::topic_qos(dds_idl::SemapTopic::kTfStatic)),
       health_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kHealth),
                     dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
       health_writer_(participant_, health_topic_, dds_idl::topic_qos(dds_idl::SemapTopic::kHealth)),
@@ -24,6 +32,18 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
                                                  config.cloud_hz},
                      map, map_blocks) {
   dds_idl::set_stamp_clock(config.stamp_clock);
+  if (!sensor_frames.empty()) {
+    const common::Stamp now = common::Stamp::now();
+    std::vector<dds_idl::msg::TransformStamped> transforms(sensor_frames.size());
+    for (std::size_t i = 0; i < sensor_frames.size(); ++i) {
+      dds_idl::to_msg(sensor_frames[i].body_from_sensor, now, config.base_frame_id,
+                      sensor_frames[i].name, transforms[i]);
+    }
+    dds_idl::msg::TFMessage m{};
+    m.transforms_ = dds_idl::borrow_sequence<dds_sequence_geometry_msgs_msg_dds__TransformStamped_>(
+        transforms.data(), transforms.size());
+    tf_static_writer_.write(m);
+  }
   if (costmap && costmaps != nullptr) {
     costmap_.emplace(participant_, config.ns, config.frame_id, *costmap, *costmaps);
   }
@@ -102,9 +122,18 @@ void DdsOutputs::publish_pose(const PoseOutput& pose) {
   p.pose_covariance.topLeftCorner<3, 3>() = pose.position_covariance;
   p.pose_covariance.bottomRightCorner<3, 3>() = pose.rotation_covariance;
   dds_idl::msg::Odometry msg{};
-  const std::string child = "base_link";
-  dds_idl::to_msg(p, config_.frame_id, child, msg);
+  dds_idl::to_msg(p, config_.frame_id, config_.base_frame_id, msg);
   odometry_writer_.write(msg);
+  // TF's map -> base_link at the odometry rate, so RViz places the cloud and the costmap.
+  Eigen::Isometry3d map_from_base = Eigen::Isometry3d::Identity();
+  map_from_base.linear() = pose.pose.orientation.toRotationMatrix();
+  map_from_base.translation() = pose.pose.position;
+  dds_idl::msg::TransformStamped transform;
+  dds_idl::to_msg(map_from_base, p.stamp, config_.frame_id, config_.base_frame_id, transform);
+  dds_idl::msg::TFMessage tf{};
+  tf.transforms_ = dds_idl::borrow_sequence<dds_sequence_geometry_msgs_msg_dds__TransformStamped_>(
+      &transform, 1);
+  tf_writer_.write(tf);
   odometry_written_.fetch_add(1);
 }
 

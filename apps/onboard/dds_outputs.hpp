@@ -19,6 +19,12 @@
 
 namespace semap::onboard {
 
+// A sensor's frame for TF: its name and where it sits on the robot (body from sensor).
+struct SensorFrame {
+  std::string name;
+  Eigen::Isometry3d body_from_sensor = Eigen::Isometry3d::Identity();
+};
+
 // The robot's DDS side: odometry from the estimation stage; map blocks, MapInfo and map_cloud
 // from the map publisher's own thread, which reads the blocks the mapping stage says changed
 // through its read-only view, at the configured rates, so a slow reader never holds up
@@ -28,8 +34,10 @@ class DdsOutputs {
   // `map_blocks` (the mapping stage's view) outlives the publisher thread: stop() first.
   // With `costmap`, also the costmap around the robot, read from `costmaps` (which outlives
   // the publisher thread too).
+  // `sensor_frames`: each sensor's frame name and pose in the body frame, published once on
+  // tf_static (transient local: a late joiner gets them too).
   DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& map,
-             const dds_idl::BlockSource& map_blocks,
+             const dds_idl::BlockSource& map_blocks, const std::vector<SensorFrame>& sensor_frames,
              const std::optional<CostmapConfig>& costmap = std::nullopt,
              const CostmapSource* costmaps = nullptr);
   ~DdsOutputs();
@@ -60,6 +68,10 @@ class DdsOutputs {
   dds_idl::Topic<dds_idl::msg::Odometry> odometry_topic_;
   dds_idl::Writer<dds_idl::msg::Odometry> odometry_writer_;
   std::atomic<std::uint64_t> odometry_written_{0};
+  dds_idl::Topic<dds_idl::msg::TFMessage> tf_topic_;
+  dds_idl::Writer<dds_idl::msg::TFMessage> tf_writer_;
+  dds_idl::Topic<dds_idl::msg::TFMessage> tf_static_topic_;
+  dds_idl::Writer<dds_idl::msg::TFMessage> tf_static_writer_;
   dds_idl::Topic<dds_idl::msg::Health> health_topic_;
   dds_idl::Writer<dds_idl::msg::Health> health_writer_;
   void run_publisher(std::stop_token stop);

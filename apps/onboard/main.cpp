@@ -35,6 +35,14 @@
 
 namespace {
 
+// The sensors' frames on the robot, for tf_static: the camera's optical frame (z forward, x
+// right) and the GNSS antenna.
+std::vector<semap::onboard::SensorFrame> sensor_frames(const semap::onboard::OnboardConfig& c) {
+  Eigen::Isometry3d antenna = Eigen::Isometry3d::Identity();
+  antenna.translation() = c.estimator.lever_arm;
+  return {{"camera_optical", c.camera.body_from_optical().cast<double>()}, {"gnss", antenna}};
+}
+
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop.store(true); }
 
@@ -220,8 +228,8 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   // mapping thread starts).
   if (config.dds.enabled)
     dds = std::make_unique<onboard::DdsOutputs>(config.dds, onboard::describe_map(config.map),
-                                                mapping_stage.blocks(), config.costmap,
-                                                &mapping_stage.costmaps());
+                                                mapping_stage.blocks(), sensor_frames(config),
+                                                config.costmap, &mapping_stage.costmaps());
   // A resumed map lives in the frame it was built in: the estimator anchors there too.
   onboard::EstimationStageConfig estimation_config{
       config.estimator, config.map.start_heading_sigma_deg, config.dds.odometry_hz};

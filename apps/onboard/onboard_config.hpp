@@ -60,6 +60,7 @@ struct DdsConfig {
   int domain = 0;
   std::string ns;
   std::string frame_id = "map";
+  std::string base_frame_id = "base_link";  // the robot's body frame in odometry and TF
   double publish_hz = 2.0;
   double cloud_hz = 0.5;
   double odometry_hz = 50.0;

@@ -110,6 +110,18 @@ void to_msg(const common::ImuSample& s, const std::string& frame_id, double gyro
   put<3>(Eigen::Matrix3d::Identity() * accel_variance, out.linear_acceleration_covariance_);
 }
 
+void to_msg(const Eigen::Isometry3d& parent_from_child, common::Stamp stamp,
+            const std::string& frame_id, const std::string& child_frame_id,
+            msg::TransformStamped& out) {
+  out = {};
+  set_header(stamp, frame_id, out.header_);
+  out.child_frame_id_ = const_cast<char*>(child_frame_id.c_str());  // read only during dds_write
+  const Eigen::Vector3d t = parent_from_child.translation();
+  const Eigen::Quaterniond q(parent_from_child.rotation());
+  out.transform_.translation_ = {t.x(), t.y(), t.z()};
+  out.transform_.rotation_ = {q.x(), q.y(), q.z(), q.w()};
+}
+
 void to_msg(const common::GnssFix& f, const std::string& frame_id, msg::NavSatFix& out) {
   using common::FixQuality;
   out = {};

@@ -29,6 +29,10 @@ std::string_view leaf(SemapTopic topic) {
       return "costmap";
     case SemapTopic::kCostmapUpdates:
       return "costmap_updates";
+    case SemapTopic::kTf:
+      return "tf";
+    case SemapTopic::kTfStatic:
+      return "tf_static";
   }
   throw std::invalid_argument("unknown SemapTopic");
 }
@@ -63,7 +67,7 @@ std::string topic_name(std::string_view ns, SemapTopic topic) {
     name += ns;
     name += '/';
   }
-  name += "semap/";
+  if (topic != SemapTopic::kTf && topic != SemapTopic::kTfStatic) name += "semap/";
   name += leaf(topic);
   return name;
 }
@@ -85,6 +89,10 @@ Qos topic_qos(SemapTopic topic) {
     case SemapTopic::kHealth:
     case SemapTopic::kCostmapUpdates:
       return std::move(Qos().reliable().keep_last(10));
+    case SemapTopic::kTf:  // as tf2_ros' broadcaster
+      return std::move(Qos().reliable().keep_last(100));
+    case SemapTopic::kTfStatic:  // as tf2_ros' static broadcaster: late joiners get the tree
+      return std::move(Qos().reliable().transient_local().keep_last(1));
   }
   throw std::invalid_argument("unknown SemapTopic");
 }

@@ -42,6 +42,11 @@ struct PoseEstimate {
 void to_msg(const common::ImuSample& s, const std::string& frame_id, double gyro_variance,
             double accel_variance, msg::Imu& out);
 void to_msg(const common::GnssFix& f, const std::string& frame_id, msg::NavSatFix& out);
+// The transform from `child_frame_id` to `frame_id` (a point in the child frame, expressed in the
+// parent frame), as TF carries it. The frame names are borrowed: valid during the write.
+void to_msg(const Eigen::Isometry3d& parent_from_child, common::Stamp stamp,
+            const std::string& frame_id, const std::string& child_frame_id,
+            msg::TransformStamped& out);
 void to_msg(const PoseEstimate& p, const std::string& frame_id, const std::string& child_frame_id,
             msg::Odometry& out);
 void to_msg(const PoseEstimate& p, const std::string& frame_id,

@@ -18,7 +18,9 @@ enum class SemapTopic {
   kMapCloud,
   kHealth,
   kCostmap,
-  kCostmapUpdates
+  kCostmapUpdates,
+  kTf,       // rt/tf, or rt/<ns>/tf: ROS's transform tree, not under semap/
+  kTfStatic  // rt/tf_static, or rt/<ns>/tf_static
 };
 
 // "rt/semap/odometry" for an empty namespace, "rt/robot1/semap/odometry" for "robot1".

@@ -13,6 +13,7 @@
 #include <sensor_msgs/msg/Imu_.h>
 #include <sensor_msgs/msg/NavSatFix_.h>
 #include <sensor_msgs/msg/PointCloud2_.h>
+#include <tf2_msgs/msg/TFMessage_.h>
 
 namespace semap::dds_idl {
 
@@ -23,6 +24,8 @@ using PoseWithCovarianceStamped = geometry_msgs_msg_dds__PoseWithCovarianceStamp
 using Odometry = nav_msgs_msg_dds__Odometry_;
 using OccupancyGrid = nav_msgs_msg_dds__OccupancyGrid_;
 using OccupancyGridUpdate = map_msgs_msg_dds__OccupancyGridUpdate_;
+using TransformStamped = geometry_msgs_msg_dds__TransformStamped_;
+using TFMessage = tf2_msgs_msg_dds__TFMessage_;
 using Imu = sensor_msgs_msg_dds__Imu_;
 using NavSatFix = sensor_msgs_msg_dds__NavSatFix_;
 using PointField = sensor_msgs_msg_dds__PointField_;
@@ -53,6 +56,7 @@ SEMAP_DDS_TYPE(msg::SemanticMapBlock, semap_msgs_msg_dds__SemanticMapBlock__desc
 SEMAP_DDS_TYPE(msg::MapInfo, semap_msgs_msg_dds__MapInfo__desc);
 SEMAP_DDS_TYPE(msg::Health, semap_msgs_msg_dds__Health__desc);
 SEMAP_DDS_TYPE(msg::OccupancyGrid, nav_msgs_msg_dds__OccupancyGrid__desc);
+SEMAP_DDS_TYPE(msg::TFMessage, tf2_msgs_msg_dds__TFMessage__desc);
 SEMAP_DDS_TYPE(msg::OccupancyGridUpdate, map_msgs_msg_dds__OccupancyGridUpdate__desc);
 
 #undef SEMAP_DDS_TYPE
