@@ -98,6 +98,43 @@ TEST(SpscRing, BatchPopIsBoundedByRequestAndContent) {
   EXPECT_EQ(ring.try_pop_batch(std::span<int>()), 0u);
 }
 
+// A batch pop hands over everything pushed since the consumer last looked, under both policies.
+TEST(SpscRing, BatchPopSeesValuesPushedSinceTheLastPop) {
+  for (const OverflowPolicy policy : {OverflowPolicy::kReject, OverflowPolicy::kDropOldest}) {
+    SpscRing<int> ring(8, policy);
+    ASSERT_TRUE(ring.try_push(0));
+    ASSERT_TRUE(ring.try_push(1));
+    int v = -1;
+    ASSERT_TRUE(ring.try_pop(v));
+    EXPECT_EQ(v, 0);
+    for (int i = 2; i < 5; ++i) ASSERT_TRUE(ring.try_push(i));
+    std::array<int, 8> out{};
+    ASSERT_EQ(ring.try_pop_batch(out), 4u);
+    EXPECT_EQ(out[0], 1);
+    EXPECT_EQ(out[3], 4);
+    EXPECT_FALSE(ring.try_pop(v));
+  }
+}
+
+// Values wider than a cache line and over-aligned (UBSan builds check the slots' alignment).
+struct alignas(128) Wide {
+  std::array<std::uint64_t, 20> words{};
+};
+
+TEST(SpscRing, OverAlignedValues) {
+  SpscRing<Wide> ring(4);
+  for (std::uint64_t i = 0; i < 10; ++i) {
+    Wide w;
+    w.words[0] = i;
+    w.words[19] = i * 3;
+    ASSERT_TRUE(ring.try_push(w));
+    Wide out;
+    ASSERT_TRUE(ring.try_pop(out));
+    EXPECT_EQ(out.words[0], i);
+    EXPECT_EQ(out.words[19], i * 3);
+  }
+}
+
 TEST(SpscRing, MoveOnlyValuesAreMoved) {
   SpscRing<std::vector<int>> ring(2);
   std::vector<int> big(1000, 7);

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -108,8 +110,14 @@ class SpscRing {
 
  private:
   static constexpr std::size_t kLine = 64;
+  static constexpr std::size_t kSlotBytes = sizeof(std::atomic<std::uint64_t>) + sizeof(T);
 
-  struct Slot {
+  // Each slot is padded to a power of two up to a line, or to whole lines, and aligned to that
+  // size (new[] honours it), so no slot straddles a line boundary. Unpadded, 64-byte values
+  // made 72-byte slots, each sharing lines with both neighbours, which producer and consumer
+  // then pulled back and forth. Small slots still pack several to a line, which pays at 8 B:
+  // one line handed over carries several values.
+  struct alignas(std::max(std::min(std::bit_ceil(kSlotBytes), kLine), alignof(T))) Slot {
     // One past the position whose value the slot holds; 0 before the first write. Slot i only
     // serves positions i + k * capacity, so a stale word never matches a later position.
     std::atomic<std::uint64_t> seq{0};
