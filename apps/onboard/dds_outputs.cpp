@@ -13,10 +13,12 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
                        const std::optional<CostmapConfig>& costmap, const CostmapSource* costmaps)
     : config_(config),
       participant_(static_cast<dds_domainid_t>(config.domain)),
-      odometry_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kOdometry),
-                      dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
-      odometry_writer_(participant_, odometry_topic_,
-                       dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry)),
+      odometry_topic_(
+          participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kOdometry),
+          dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry, config.sensor_reliability)),
+      odometry_writer_(
+          participant_, odometry_topic_,
+          dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry, config.sensor_reliability)),
       tf_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kTf),
                 dds_idl::topic_qos(dds_idl::SemapTopic::kTf)),
       tf_writer_(participant_, tf_topic_, dds_idl::topic_qos(dds_idl::SemapTopic::kTf)),

@@ -171,6 +171,8 @@ void read_dds(const ConfigSection& s, DdsConfig& dds) {
   dds.ns = s.get<std::string>("namespace", "");
   dds.frame_id = s.get<std::string>("frame_id", "map");
   dds.base_frame_id = s.get<std::string>("base_frame_id", "base_link");
+  dds.sensor_reliability = dds_idl::sensor_reliability_from_string(
+      s.get_choice("sensor_reliability", "best_effort", {"best_effort", "reliable"}));
   dds.publish_hz = s.get_in_range("publish_hz", dds.publish_hz, 0.1, 100.0);
   dds.cloud_hz = s.get_in_range("cloud_hz", dds.cloud_hz, 0.0, 10.0);
   dds.odometry_hz = s.get_in_range("odometry_hz", dds.odometry_hz, 1.0, 1000.0);

@@ -9,6 +9,7 @@
 #include "costmap_output.hpp"
 #include "perception_config.hpp"
 #include "semap/dds_idl/converters.hpp"
+#include "semap/dds_idl/topic_names.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/drivers/gnss_driver.hpp"
 #include "semap/estimation/estimator_config.hpp"
@@ -64,6 +65,8 @@ struct DdsConfig {
   double publish_hz = 2.0;
   double cloud_hz = 0.5;
   double odometry_hz = 50.0;
+  // odometry: best effort (ROS's sensor-data QoS) or reliable, for default ROS subscribers.
+  dds_idl::SensorReliability sensor_reliability = dds_idl::SensorReliability::kBestEffort;
   // Header stamps: ROS time (the system clock) or the pipeline's CLOCK_MONOTONIC.
   dds_idl::StampClock stamp_clock = dds_idl::StampClock::kRealtime;
 };

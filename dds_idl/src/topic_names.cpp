@@ -72,12 +72,26 @@ std::string topic_name(std::string_view ns, SemapTopic topic) {
   return name;
 }
 
-Qos topic_qos(SemapTopic topic) {
+SensorReliability sensor_reliability_from_string(const std::string& name) {
+  if (name == "best_effort") return SensorReliability::kBestEffort;
+  if (name == "reliable") return SensorReliability::kReliable;
+  throw std::invalid_argument("unknown sensor reliability '" + name +
+                              "' (best_effort or reliable)");
+}
+
+Qos topic_qos(SemapTopic topic, SensorReliability sensors) {
   switch (topic) {
     case SemapTopic::kOdometry:
     case SemapTopic::kGnss:
-    case SemapTopic::kImu:
-      return std::move(Qos().best_effort().keep_last(topic == SemapTopic::kOdometry ? 1 : 10));
+    case SemapTopic::kImu: {
+      Qos qos;
+      if (sensors == SensorReliability::kReliable) {
+        qos.reliable();
+      } else {
+        qos.best_effort();
+      }
+      return std::move(qos.keep_last(topic == SemapTopic::kOdometry ? 1 : 10));
+    }
     case SemapTopic::kPose:
       return std::move(Qos().reliable().keep_last(1));
     case SemapTopic::kMapBlocks:

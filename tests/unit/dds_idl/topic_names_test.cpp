@@ -33,6 +33,14 @@ TEST(TopicNames, QosMatchesTheDesign) {
   const Qos odom = topic_qos(SemapTopic::kOdometry);
   ASSERT_TRUE(dds_qget_reliability(odom.get(), &rel, &blocking));
   EXPECT_EQ(rel, DDS_RELIABILITY_BEST_EFFORT);
+  // dds.sensor_reliability: reliable, for subscribers with ROS's default QoS; same depth.
+  const Qos reliable_imu = topic_qos(SemapTopic::kImu, SensorReliability::kReliable);
+  ASSERT_TRUE(dds_qget_reliability(reliable_imu.get(), &rel, &blocking));
+  EXPECT_EQ(rel, DDS_RELIABILITY_RELIABLE);
+  ASSERT_TRUE(dds_qget_history(reliable_imu.get(), &hist, &depth));
+  EXPECT_EQ(depth, 10);
+  EXPECT_EQ(sensor_reliability_from_string("reliable"), SensorReliability::kReliable);
+  EXPECT_THROW(sensor_reliability_from_string("sometimes"), std::invalid_argument);
 
   const Qos health = topic_qos(SemapTopic::kHealth);
   ASSERT_TRUE(dds_qget_reliability(health.get(), &rel, &blocking));
