@@ -17,17 +17,12 @@ Seq borrow_cells(const std::vector<std::int8_t>& cells) {
       reinterpret_cast<std::uint8_t*>(const_cast<std::int8_t*>(cells.data())), cells.size());
 }
 
-void set_header(common::Stamp stamp, const std::string& frame_id, dds_idl::msg::Header& h) {
-  h.stamp_ = dds_idl::to_msg_time(stamp);
-  h.frame_id_ = const_cast<char*>(frame_id.c_str());  // read only during dds_write
-}
-
 }  // namespace
 
 void to_msg(const mapping::Costmap& costmap, common::Stamp stamp, const std::string& frame_id,
             dds_idl::msg::OccupancyGrid& out) {
   out = {};
-  set_header(stamp, frame_id, out.header_);
+  dds_idl::set_header(stamp, frame_id, out.header_);
   out.info_.map_load_time_ = out.header_.stamp_;
   out.info_.resolution_ = static_cast<float>(costmap.resolution);
   out.info_.width_ = static_cast<std::uint32_t>(costmap.width);
@@ -40,7 +35,7 @@ void to_msg(const mapping::Costmap& costmap, common::Stamp stamp, const std::str
 void to_msg(const mapping::CostmapUpdate& update, common::Stamp stamp, const std::string& frame_id,
             dds_idl::msg::OccupancyGridUpdate& out) {
   out = {};
-  set_header(stamp, frame_id, out.header_);
+  dds_idl::set_header(stamp, frame_id, out.header_);
   out.x_ = update.x;
   out.y_ = update.y;
   out.width_ = static_cast<std::uint32_t>(update.width);
@@ -62,9 +57,7 @@ CostmapOutput::CostmapOutput(const dds_idl::Participant& participant, const std:
       update_writer_(participant, update_topic_,
                      dds_idl::topic_qos(dds_idl::SemapTopic::kCostmapUpdates)) {}
 
-void CostmapOutput::changed(std::span<const common::BlockIndex> blocks) {
-  pending_.insert(blocks.begin(), blocks.end());
-}
+void CostmapOutput::changed(const common::BlockIndex& block) { pending_.insert(block); }
 
 bool CostmapOutput::needs_rebuild(const Eigen::Vector2d& robot) const {
   if (!costmap_ || config_.params.whole_map()) return true;

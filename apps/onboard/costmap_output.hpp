@@ -58,8 +58,8 @@ class CostmapOutput {
   CostmapOutput(const dds_idl::Participant& participant, const std::string& ns,
                 std::string frame_id, const CostmapConfig& config, const CostmapSource& source);
 
-  // Publisher thread: blocks the map changed.
-  void changed(std::span<const common::BlockIndex> blocks);
+  // Publisher thread: a block the map changed.
+  void changed(const common::BlockIndex& block);
   // Publisher thread: a round when one is due and the robot's position is known.
   void spin_once(common::Stamp now, const std::optional<Eigen::Vector2d>& robot);
   const Counters& counters() const { return counters_; }

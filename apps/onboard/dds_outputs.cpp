@@ -77,10 +77,9 @@ void DdsOutputs::take_changed() {
     std::lock_guard lock(changed_mutex_);
     changed.swap(changed_);
   }
-  for (const auto& index : changed) map_publisher_.changed(index);
-  if (costmap_) {
-    const std::vector<common::BlockIndex> blocks(changed.begin(), changed.end());
-    costmap_->changed(blocks);
+  for (const auto& index : changed) {
+    map_publisher_.changed(index);
+    if (costmap_) costmap_->changed(index);
   }
 }
 

@@ -16,11 +16,6 @@ constexpr std::int64_t kNsPerSec = 1'000'000'000;
 // A NavSatStatus value as the octet that carries the msg's int8.
 std::uint8_t octet(std::int8_t status) { return static_cast<std::uint8_t>(status); }
 
-void set_header(common::Stamp stamp, const std::string& frame_id, msg::Header& h) {
-  h.stamp_ = to_msg_time(stamp);
-  h.frame_id_ = const_cast<char*>(frame_id.c_str());  // read only during dds_write
-}
-
 template <int N>
 void put(const Eigen::Matrix<double, N, N>& m, double* out) {
   Eigen::Map<Eigen::Matrix<double, N, N, Eigen::RowMajor>> dst(out);
@@ -91,6 +86,11 @@ msg::Time to_msg_time(common::Stamp stamp) {
   const std::int64_t out = stamp_clock() == StampClock::kRealtime ? realtime_of(stamp) : stamp.ns;
   const std::int64_t ns = std::max<std::int64_t>(out, 0);
   return {static_cast<std::int32_t>(ns / kNsPerSec), static_cast<std::uint32_t>(ns % kNsPerSec)};
+}
+
+void set_header(common::Stamp stamp, const std::string& frame_id, msg::Header& h) {
+  h.stamp_ = to_msg_time(stamp);
+  h.frame_id_ = const_cast<char*>(frame_id.c_str());  // read only during dds_write
 }
 
 common::Stamp from_msg_time(const msg::Time& t) {

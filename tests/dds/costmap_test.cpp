@@ -136,7 +136,7 @@ TEST_F(DdsTest, Nav2GetsTheCostmapJoiningLateAndFollowsItsUpdates) {
 
   // A car parks at (1.1, 1.1): the next round sends the rectangle around it, and the grid.
   const mapping::InsertResult car = map.insert(layer(1.0f, 1.2f, 1.0f, 1.2f, 0.5f, 2));
-  output.changed(car.updated_blocks);
+  for (const common::BlockIndex& block : car.updated_blocks) output.changed(block);
   output.spin_once(t0 + 1.0, robot);
   const auto update = wait_for<msg::OccupancyGridUpdate>(
       updates, [](const msg::OccupancyGridUpdate& m) { return m.width_ > 0; });

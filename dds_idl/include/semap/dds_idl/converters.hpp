@@ -25,6 +25,8 @@ StampClock stamp_clock_from_string(const std::string& name);
 // Negative times are clamped to zero (builtin_interfaces/Time cannot carry them meaningfully).
 msg::Time to_msg_time(common::Stamp stamp);
 common::Stamp from_msg_time(const msg::Time& t);
+// A header of `stamp` (to_msg_time) in `frame_id`, which it borrows: valid during the write.
+void set_header(common::Stamp stamp, const std::string& frame_id, msg::Header& h);
 
 // A pose estimate with its velocity, the plain form of nav_msgs/Odometry. Covariances are in
 // ROS order: (x, y, z, rotation about x, y, z); twist in the body (child) frame.
