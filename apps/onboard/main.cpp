@@ -407,9 +407,9 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
     const auto m = dds->map_counters();
     std::printf(
         "dds              : %lu odometry samples, %lu block samples in %lu rounds, "
-        "%lu map clouds, %lu health reports\n",
+        "%lu map clouds, %lu cloud updates (%lu points), %lu health reports\n",
         dds->odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
-        dds->health_written());
+        m.cloud_updates_written, m.cloud_update_points, dds->health_written());
     if (const auto c = dds->costmap_counters()) {
       std::printf(
           "costmap          : %lu grids (%lu rebuilt around the robot), %lu updates, last round "

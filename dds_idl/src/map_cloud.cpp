@@ -40,7 +40,9 @@ MapCloud::MapCloud(std::string frame_id, std::vector<std::uint32_t> class_colors
 
 void MapCloud::add(const Eigen::Vector3f& p, std::uint16_t cls, float variance) {
   std::array<std::uint8_t, kPointStep> point{};
-  const std::uint32_t rgb = cls < class_colors_.size() ? class_colors_[cls] & 0xFFFFFF : kGrey;
+  const std::uint32_t rgb = cls == kRemovedClass         ? 0
+                            : cls < class_colors_.size() ? class_colors_[cls] & 0xFFFFFF
+                                                         : kGrey;
   std::memcpy(point.data(), p.data(), 12);
   std::memcpy(point.data() + 12, &rgb, 4);
   std::memcpy(point.data() + 16, &variance, 4);
@@ -53,6 +55,17 @@ void MapCloud::add_occupied(const BlockSnapshot& block) {
     if (block.state[i] == common::CellState::kOccupied) {
       add(block.cell_center(i), block.argmax_class[i], block.variance[i]);
     }
+  }
+}
+
+void MapCloud::add_changed(const BlockSnapshot& block, std::vector<std::uint16_t>& sent) {
+  sent.resize(block.state.size(), kRemovedClass);
+  for (std::size_t i = 0; i < block.state.size(); ++i) {
+    const std::uint16_t now =
+        block.state[i] == common::CellState::kOccupied ? block.argmax_class[i] : kRemovedClass;
+    if (now == sent[i]) continue;
+    add(block.cell_center(i), now, now == kRemovedClass ? 0.0f : block.variance[i]);
+    sent[i] = now;
   }
 }
 

@@ -46,6 +46,9 @@ MapPublisher::MapPublisher(const Participant& participant, MapPublisherConfig co
       cloud_topic_(participant, topic_name(config_.ns, SemapTopic::kMapCloud)),
       cloud_writer_(participant, cloud_topic_, topic_qos(SemapTopic::kMapCloud)),
       cloud_(config_.frame_id, description_.class_colors),
+      updates_topic_(participant, topic_name(config_.ns, SemapTopic::kMapCloudUpdates)),
+      updates_writer_(participant, updates_topic_, topic_qos(SemapTopic::kMapCloudUpdates)),
+      updates_(config_.frame_id, description_.class_colors),
       source_(source) {
   if (config_.blocks_hz <= 0.0) throw std::invalid_argument("MapPublisher: blocks_hz must be > 0");
   if (description_.num_classes == 0) {
@@ -89,6 +92,7 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
   }
   if (info_dirty_) publish_info(now);
   std::size_t written = 0;
+  updates_.clear();
   // A round of blocks goes out as few full packets when the configuration batches writes
   // (the loopback XML does), and is flushed before returning so that nothing waits.
   for (auto it = changed_.begin(); it != changed_.end();) {
@@ -105,12 +109,18 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
       ++counters_.write_timeouts;
       break;
     }
+    if (config_.cloud_hz > 0.0) updates_.add_changed(scratch_, sent_classes_[*it]);
     it = changed_.erase(it);
     ++written;
   }
   block_writer_.flush();
   counters_.blocks_written += written;
   if (written > 0) ++counters_.block_publications;
+  if (updates_.size() > 0) {
+    updates_writer_.write(updates_.message(now));
+    ++counters_.cloud_updates_written;
+    counters_.cloud_update_points += updates_.size();
+  }
   return written;
 }
 

@@ -23,6 +23,8 @@ std::string_view leaf(SemapTopic topic) {
       return "map_info";
     case SemapTopic::kMapCloud:
       return "map_cloud";
+    case SemapTopic::kMapCloudUpdates:
+      return "map_cloud_updates";
     case SemapTopic::kHealth:
       return "health";
     case SemapTopic::kCostmap:
@@ -101,6 +103,7 @@ Qos topic_qos(SemapTopic topic, SensorReliability sensors) {
       // Late joiners get the current version of every block from the writer's history.
       return std::move(Qos().reliable().transient_local().keep_last(1));
     case SemapTopic::kHealth:
+    case SemapTopic::kMapCloudUpdates:
     case SemapTopic::kCostmapUpdates:
       return std::move(Qos().reliable().keep_last(10));
     case SemapTopic::kTf:  // as tf2_ros' broadcaster

@@ -53,6 +53,8 @@ const std::vector<Expected>& expected_topics() {
        DDS_DURABILITY_VOLATILE, 10},
       {"map_cloud", "sensor_msgs::msg::dds_::PointCloud2_", "sensor_msgs/msg/PointCloud2",
        DDS_RELIABILITY_RELIABLE, DDS_DURABILITY_TRANSIENT_LOCAL, 1},
+      {"map_cloud_updates", "sensor_msgs::msg::dds_::PointCloud2_", "sensor_msgs/msg/PointCloud2",
+       DDS_RELIABILITY_RELIABLE, DDS_DURABILITY_VOLATILE, 10},
       {"map_blocks", "semap_msgs::msg::dds_::SemanticMapBlock_", "semap_msgs/msg/SemanticMapBlock",
        DDS_RELIABILITY_RELIABLE, DDS_DURABILITY_TRANSIENT_LOCAL, 1, true},
       {"map_info", "semap_msgs::msg::dds_::MapInfo_", "semap_msgs/msg/MapInfo",

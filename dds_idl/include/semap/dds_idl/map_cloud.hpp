@@ -19,6 +19,8 @@ namespace semap::dds_idl {
 class MapCloud {
  public:
   static constexpr std::uint32_t kPointStep = 24;
+  // In map_cloud_updates: the cell at this point is no longer occupied.
+  static constexpr std::uint16_t kRemovedClass = 0xFFFF;
 
   // `class_colors`: 0xRRGGBB per class (MapDescription::class_colors); classes beyond it are
   // grey.
@@ -29,6 +31,11 @@ class MapCloud {
   void clear() { data_.clear(); }
   void add(const Eigen::Vector3f& p, std::uint16_t cls, float variance);
   void add_occupied(const BlockSnapshot& block);
+  // The cells of `block` whose occupancy or class differs from `sent` (one class per cell,
+  // kRemovedClass for a cell not occupied; empty: none sent yet), which it then updates: a
+  // newly occupied or relabelled cell with its class and variance, a cell no longer occupied
+  // with kRemovedClass.
+  void add_changed(const BlockSnapshot& block, std::vector<std::uint16_t>& sent);
   std::size_t size() const { return data_.size() / kPointStep; }
 
   // The message borrows this object's buffers: valid until the next add/clear.

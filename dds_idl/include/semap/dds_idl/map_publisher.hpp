@@ -18,13 +18,15 @@ struct MapPublisherConfig {
   std::string ns;  // topic namespace: "" or e.g. "robot1"
   std::string frame_id = "map";
   double blocks_hz = 2.0;  // changed blocks and MapInfo
-  double cloud_hz = 0.5;   // map_cloud for RViz; 0 disables it
+  double cloud_hz = 0.5;   // map_cloud for RViz; 0 disables it and map_cloud_updates
 };
 
 struct MapPublisherCounters {
   std::uint64_t blocks_written = 0;
   std::uint64_t block_publications = 0;  // rounds with at least one changed block
   std::uint64_t clouds_written = 0;
+  std::uint64_t cloud_updates_written = 0;
+  std::uint64_t cloud_update_points = 0;
   std::uint64_t infos_written = 0;
   // Rounds cut short because a reliable reader did not keep up within the blocking time; the
   // unsent blocks stay pending for the next round.
@@ -60,8 +62,9 @@ class SnapshotStore : public BlockSource {
 
 // The mapping side of the map topics. The producer says which blocks changed with changed();
 // spin_once() reads those from the source and writes them at blocks_hz (each block once, in
-// its latest version), MapInfo when the map grew, and map_cloud (every block's occupied cells)
-// at cloud_hz. Not thread safe: call from one thread.
+// its latest version) with, in the same round, map_cloud_updates (the cells of those blocks whose
+// occupancy or class changed since they were last sent), MapInfo when the map grew, and
+// map_cloud (every block's occupied cells) at cloud_hz. Not thread safe: call from one thread.
 class MapPublisher {
  public:
   // `source` outlives the publisher.
@@ -99,6 +102,13 @@ class MapPublisher {
   Topic<msg::PointCloud2> cloud_topic_;
   Writer<msg::PointCloud2> cloud_writer_;
   MapCloud cloud_;
+  Topic<msg::PointCloud2> updates_topic_;
+  Writer<msg::PointCloud2> updates_writer_;
+  MapCloud updates_;
+  // Per published block, each cell's class as map_cloud_updates last gave it
+  // (MapCloud::kRemovedClass: not occupied).
+  std::unordered_map<common::BlockIndex, std::vector<std::uint16_t>, common::BlockIndexHash>
+      sent_classes_;
   const BlockSource& source_;
   BlockSnapshot scratch_;  // the block being written, its buffers reused
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> known_;

@@ -16,6 +16,7 @@ enum class SemapTopic {
   kMapBlocks,
   kMapInfo,
   kMapCloud,
+  kMapCloudUpdates,
   kHealth,
   kCostmap,
   kCostmapUpdates,
