@@ -94,7 +94,7 @@ void DdsOutputs::run_publisher(std::stop_token stop) {
   while (!stop.stop_requested()) {
     take_changed();
     const common::Stamp now = common::Stamp::now();
-    map_publisher_.spin_once(now);
+    // The costmap first: a planner waits for it, the map blocks take longer to write.
     if (costmap_) {
       std::optional<Eigen::Vector2d> robot;
       {
@@ -103,6 +103,7 @@ void DdsOutputs::run_publisher(std::stop_token stop) {
       }
       costmap_->spin_once(now, robot);
     }
+    map_publisher_.spin_once(now);
     update_counters();
     std::this_thread::sleep_for(kTick);
   }

@@ -21,15 +21,16 @@ dds_idl::MapDescription describe_map(const MappingConfig& config) {
   return d;
 }
 
-dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
-                                   const mapping::Block& block, std::uint32_t version) {
+void to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
+                 const mapping::Block& block, std::uint32_t version, bool with_evidence,
+                 dds_idl::BlockSnapshot& out) {
   const auto& params = map.params();
   std::vector<std::uint8_t> observed(static_cast<std::size_t>(block.num_cells()));
   for (int c = 0; c < block.num_cells(); ++c) {
     observed[static_cast<std::size_t>(c)] = block.observed(c) ? 1 : 0;
   }
-  return dds_idl::snapshot_of_evidence(index, params.grid(), block.channels(), block.evidence(),
-                                       observed, params.prior, params.unknown_variance, version);
+  dds_idl::snapshot_of_evidence(index, params.grid(), block.channels(), block.evidence(), observed,
+                                params.prior, params.unknown_variance, version, with_evidence, out);
 }
 
 MappingStage::MappingStage(const MappingConfig& config,
@@ -166,11 +167,20 @@ void MappingStage::for_each_block(const std::function<void(const common::BlockIn
 }
 
 bool MappingStage::read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const {
+  return read_block(index, true, out);
+}
+
+bool MappingStage::read_cells(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const {
+  return read_block(index, false, out);
+}
+
+bool MappingStage::read_block(const common::BlockIndex& index, bool with_evidence,
+                              dds_idl::BlockSnapshot& out) const {
   std::shared_lock lock(map_mutex_);
   const auto version = versions_.find(index);
   const std::uint32_t v = version == versions_.end() ? 0 : version->second;
   if (const mapping::Block* block = map_.find_block(index)) {
-    out = to_snapshot(map_, index, *block, v);
+    to_snapshot(map_, index, *block, v, with_evidence, out);
     return true;
   }
   // Paged out: the log holds its latest state.
@@ -181,9 +191,9 @@ bool MappingStage::read(const common::BlockIndex& index, dds_idl::BlockSnapshot&
   for (std::size_t c = 0; c < observed.size(); ++c) {
     observed[c] = (observed_words[c / 64] >> (c % 64)) & 1u;
   }
-  out = dds_idl::snapshot_of_evidence(index, config_.params.grid(), config_.params.num_classes,
-                                      evidence, observed, config_.params.prior,
-                                      config_.params.unknown_variance, v);
+  dds_idl::snapshot_of_evidence(index, config_.params.grid(), config_.params.num_classes, evidence,
+                                observed, config_.params.prior, config_.params.unknown_variance, v,
+                                with_evidence, out);
   return true;
 }
 

@@ -80,6 +80,9 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   // BlockSource, for the publisher's thread.
   void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const override;
   bool read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
+  bool read_cells(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
+  bool read_block(const common::BlockIndex& index, bool with_evidence,
+                  dds_idl::BlockSnapshot& out) const;
   // CostmapSource, for the publisher's thread.
   mapping::Costmap build_costmap(const mapping::CostmapParams& p,
                                  const Eigen::Vector2d& centre) const override;
@@ -103,8 +106,10 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
 // The map's shape and its palette's class names and colours (0xRRGGBB), for MapInfo.
 dds_idl::MapDescription describe_map(const MappingConfig& config);
 
-// A block of the map in the form the DDS layer publishes.
-dds_idl::BlockSnapshot to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
-                                   const mapping::Block& block, std::uint32_t version);
+// A block of the map in the form the DDS layer publishes, into `out` (its buffers reused); its
+// evidence only `with_evidence`.
+void to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& index,
+                 const mapping::Block& block, std::uint32_t version, bool with_evidence,
+                 dds_idl::BlockSnapshot& out);
 
 }  // namespace semap::onboard

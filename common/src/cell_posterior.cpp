@@ -46,4 +46,22 @@ int CellPosterior::label(float unknown_variance) const {
   return state(unknown_variance) == CellState::kUnknown ? -1 : argmax();
 }
 
+CellPosterior::Summary CellPosterior::summary(float unknown_variance) const {
+  Summary s;
+  float sum = 0.0f;
+  for (int k = 0; k < num_classes(); ++k) {
+    const float e = evidence_[static_cast<std::size_t>(k)];
+    if (e > evidence_[static_cast<std::size_t>(s.argmax)]) s.argmax = k;
+    sum += prior_ + e;
+  }
+  const float m = alpha(s.argmax) / sum;
+  s.variance = m * (1.0f - m) / (sum + 1.0f);
+  if (!observed_ || (unknown_variance > 0.0f && s.variance > unknown_variance)) {
+    s.state = CellState::kUnknown;
+  } else {
+    s.state = s.argmax == 0 ? CellState::kFree : CellState::kOccupied;
+  }
+  return s;
+}
+
 }  // namespace semap::common

@@ -33,24 +33,41 @@ BlockSnapshot snapshot_of_evidence(common::BlockIndex index, const common::MapGr
                                    int num_classes, std::span<const float> evidence,
                                    std::span<const std::uint8_t> observed, float prior,
                                    float unknown_variance, std::uint32_t version) {
-  auto snap =
-      BlockSnapshot::empty(index, grid.resolution(), static_cast<std::uint16_t>(grid.block_side()),
-                           static_cast<std::uint16_t>(num_classes), true);
-  snap.version = version;
-  std::copy(evidence.begin(), evidence.end(), snap.evidence.begin());
+  BlockSnapshot snap;
+  snapshot_of_evidence(index, grid, num_classes, evidence, observed, prior, unknown_variance,
+                       version, true, snap);
+  return snap;
+}
+
+void snapshot_of_evidence(common::BlockIndex index, const common::MapGrid& grid, int num_classes,
+                          std::span<const float> evidence, std::span<const std::uint8_t> observed,
+                          float prior, float unknown_variance, std::uint32_t version,
+                          bool with_evidence, BlockSnapshot& out) {
+  out.index = index;
+  out.resolution = grid.resolution();
+  out.block_cells = static_cast<std::uint16_t>(grid.block_side());
+  out.num_classes = static_cast<std::uint16_t>(num_classes);
+  out.version = version;
+  const std::size_t cells = out.cell_count();
+  out.state.resize(cells);
+  out.argmax_class.resize(cells);
+  out.variance.resize(cells);
+  if (with_evidence) {
+    out.evidence.assign(evidence.begin(), evidence.end());
+  } else {
+    out.evidence.clear();
+  }
   const auto k = static_cast<std::size_t>(num_classes);
-  for (std::size_t cell = 0; cell < snap.cell_count(); ++cell) {
+  for (std::size_t cell = 0; cell < cells; ++cell) {
     const std::span<const float> e = evidence.subspan(cell * k, k);
     const bool seen = observed.empty()
                           ? std::any_of(e.begin(), e.end(), [](float v) { return v > 0.0f; })
                           : observed[cell] != 0;
-    const common::CellPosterior post(e, prior, seen);
-    snap.state[cell] = post.state(unknown_variance);
-    const int best = post.argmax();
-    snap.argmax_class[cell] = static_cast<std::uint16_t>(best);
-    snap.variance[cell] = post.variance(best);
+    const auto s = common::CellPosterior(e, prior, seen).summary(unknown_variance);
+    out.state[cell] = s.state;
+    out.argmax_class[cell] = static_cast<std::uint16_t>(s.argmax);
+    out.variance[cell] = s.variance;
   }
-  return snap;
 }
 
 }  // namespace semap::dds_idl

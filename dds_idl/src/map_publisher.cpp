@@ -91,8 +91,8 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
     if (known_.insert(index).second) info_dirty_ = true;
   }
   if (info_dirty_) publish_info(now);
+  if (config_.cloud_hz > 0.0) publish_cloud_updates(now);
   std::size_t written = 0;
-  updates_.clear();
   // A round of blocks goes out as few full packets when the configuration batches writes
   // (the loopback XML does), and is flushed before returning so that nothing waits.
   for (auto it = changed_.begin(); it != changed_.end();) {
@@ -109,25 +109,32 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
       ++counters_.write_timeouts;
       break;
     }
-    if (config_.cloud_hz > 0.0) updates_.add_changed(scratch_, sent_classes_[*it]);
     it = changed_.erase(it);
     ++written;
   }
   block_writer_.flush();
   counters_.blocks_written += written;
   if (written > 0) ++counters_.block_publications;
-  if (updates_.size() > 0) {
-    updates_writer_.write(updates_.message(now));
-    ++counters_.cloud_updates_written;
-    counters_.cloud_update_points += updates_.size();
-  }
   return written;
+}
+
+// Before the blocks, from the cells alone: the update is a small message that planners wait
+// for, the blocks carry all the evidence.
+void MapPublisher::publish_cloud_updates(common::Stamp now) {
+  updates_.clear();
+  for (const common::BlockIndex& index : changed_) {
+    if (source_.read_cells(index, scratch_)) updates_.add_changed(scratch_, sent_classes_[index]);
+  }
+  if (updates_.size() == 0) return;
+  updates_writer_.write(updates_.message(now));
+  ++counters_.cloud_updates_written;
+  counters_.cloud_update_points += updates_.size();
 }
 
 void MapPublisher::publish_cloud(common::Stamp now) {
   cloud_.clear();
   source_.for_each_block([&](const common::BlockIndex& index) {
-    if (source_.read(index, scratch_)) cloud_.add_occupied(scratch_);
+    if (source_.read_cells(index, scratch_)) cloud_.add_occupied(scratch_);
   });
   cloud_writer_.write(cloud_.message(now));
   ++counters_.clouds_written;

@@ -71,7 +71,9 @@ TEST_F(DdsTest, RobotAndClientAgreeOnTheCellOfPointsAtBlockFaces) {
     MapPublisher publisher(participant, {ns, "map", 20.0, 0.0}, description, publisher_blocks);
     std::size_t blocks = 0;
     map.for_each_block([&](const common::BlockIndex& index, const mapping::Block& block) {
-      publisher.changed(publisher_blocks.put(onboard::to_snapshot(map, index, block, 1)));
+      BlockSnapshot snapshot;
+      onboard::to_snapshot(map, index, block, 1, true, snapshot);
+      publisher.changed(publisher_blocks.put(std::move(snapshot)));
       ++blocks;
     });
     publisher.publish_changed(common::Stamp::now());

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
 #include <vector>
 
 namespace semap::common {
@@ -48,6 +49,25 @@ TEST(CellPosterior, VarianceThresholdTurnsUncertainCellsUnknown) {
   EXPECT_EQ(cell.state(var * 0.5f), CellState::kUnknown);
   EXPECT_EQ(cell.state(var * 2.0f), CellState::kOccupied);
   EXPECT_EQ(cell.state(0.0f), CellState::kOccupied);  // off by default
+}
+
+// The one-pass summary the map publishes equals the separate calls, ties and unobserved
+// cells included, with and without a variance threshold.
+TEST(CellPosterior, SummaryEqualsStateArgmaxAndVariance) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> small(0, 3);
+  std::uniform_real_distribution<float> real(0.0f, 5.0f);
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::vector<float> e(static_cast<std::size_t>(1 + trial % 20));
+    for (float& v : e) v = trial % 2 ? static_cast<float>(small(rng)) : real(rng);  // ties too
+    const CellPosterior post(e, 0.001f, trial % 7 != 0);
+    for (const float threshold : {0.0f, 0.05f}) {
+      const auto s = post.summary(threshold);
+      EXPECT_EQ(s.argmax, post.argmax());
+      EXPECT_EQ(s.state, post.state(threshold));
+      EXPECT_EQ(s.variance, post.variance(post.argmax()));
+    }
+  }
 }
 
 }  // namespace

@@ -34,6 +34,15 @@ class CellPosterior {
   // argmax, or -1 when the state is unknown.
   int label(float unknown_variance = 0.0f) const;
 
+  // state(), argmax() and variance(argmax()) from one pass over the classes (equal to them):
+  // what a map publishes per cell.
+  struct Summary {
+    CellState state = CellState::kUnknown;
+    int argmax = 0;
+    float variance = 0.0f;
+  };
+  Summary summary(float unknown_variance = 0.0f) const;
+
  private:
   std::span<const float> evidence_;
   float prior_;

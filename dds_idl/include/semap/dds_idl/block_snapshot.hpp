@@ -47,5 +47,11 @@ BlockSnapshot snapshot_of_evidence(common::BlockIndex index, const common::MapGr
                                    int num_classes, std::span<const float> evidence,
                                    std::span<const std::uint8_t> observed, float prior,
                                    float unknown_variance, std::uint32_t version);
+// The same into `out`, reusing its buffers; without `with_evidence`, out.evidence is left empty
+// (a map cloud needs only the cells).
+void snapshot_of_evidence(common::BlockIndex index, const common::MapGrid& grid, int num_classes,
+                          std::span<const float> evidence, std::span<const std::uint8_t> observed,
+                          float prior, float unknown_variance, std::uint32_t version,
+                          bool with_evidence, BlockSnapshot& out);
 
 }  // namespace semap::dds_idl

@@ -43,6 +43,13 @@ class BlockSource {
   virtual void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const = 0;
   // The block at `index` into `out`, reusing its buffers; false when there is none (any more).
   virtual bool read(const common::BlockIndex& index, BlockSnapshot& out) const = 0;
+  // The same without evidence (out.evidence empty), for the map cloud; a source that can skip
+  // copying the evidence overrides it.
+  virtual bool read_cells(const common::BlockIndex& index, BlockSnapshot& out) const {
+    if (!read(index, out)) return false;
+    out.evidence.clear();
+    return true;
+  }
 };
 
 // A BlockSource that keeps snapshots: for producers that hold no semap map (simulated blocks,
@@ -62,8 +69,8 @@ class SnapshotStore : public BlockSource {
 
 // The mapping side of the map topics. The producer says which blocks changed with changed();
 // spin_once() reads those from the source and writes them at blocks_hz (each block once, in
-// its latest version) with, in the same round, map_cloud_updates (the cells of those blocks whose
-// occupancy or class changed since they were last sent), MapInfo when the map grew, and
+// its latest version) after, in the same round, map_cloud_updates (the cells of those blocks
+// whose occupancy or class changed since they were last sent), MapInfo when the map grew, and
 // map_cloud (every block's occupied cells) at cloud_hz. Not thread safe: call from one thread.
 class MapPublisher {
  public:
@@ -91,6 +98,7 @@ class MapPublisher {
 
  private:
   void publish_info(common::Stamp now);
+  void publish_cloud_updates(common::Stamp now);
   void check_shape(const BlockSnapshot& block) const;
 
   MapPublisherConfig config_;
