@@ -94,7 +94,9 @@ void DdsOutputs::run_publisher(std::stop_token stop) {
   while (!stop.stop_requested()) {
     take_changed();
     const common::Stamp now = common::Stamp::now();
-    // The costmap first: a planner waits for it, the map blocks take longer to write.
+    // What planners wait for first (the cloud's and the costmap's changes), the map blocks,
+    // which take longest to write, last.
+    map_publisher_.spin_updates(now);
     if (costmap_) {
       std::optional<Eigen::Vector2d> robot;
       {

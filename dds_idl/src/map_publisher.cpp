@@ -71,7 +71,14 @@ void MapPublisher::check_shape(const BlockSnapshot& block) const {
   }
 }
 
-void MapPublisher::changed(const common::BlockIndex& index) { changed_.insert(index); }
+void MapPublisher::changed(const common::BlockIndex& index) {
+  changed_.insert(index);
+  updates_due_ = true;
+}
+
+void MapPublisher::spin_updates(common::Stamp now) {
+  if (now >= next_blocks_ && config_.cloud_hz > 0.0 && updates_due_) publish_cloud_updates(now);
+}
 
 std::size_t MapPublisher::spin_once(common::Stamp now) {
   std::size_t written = 0;
@@ -91,7 +98,7 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
     if (known_.insert(index).second) info_dirty_ = true;
   }
   if (info_dirty_) publish_info(now);
-  if (config_.cloud_hz > 0.0) publish_cloud_updates(now);
+  if (config_.cloud_hz > 0.0 && updates_due_) publish_cloud_updates(now);
   std::size_t written = 0;
   // A round of blocks goes out as few full packets when the configuration batches writes
   // (the loopback XML does), and is flushed before returning so that nothing waits.
@@ -121,6 +128,7 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
 // Before the blocks, from the cells alone: the update is a small message that planners wait
 // for, the blocks carry all the evidence.
 void MapPublisher::publish_cloud_updates(common::Stamp now) {
+  updates_due_ = false;
   updates_.clear();
   for (const common::BlockIndex& index : changed_) {
     if (source_.read_cells(index, scratch_)) updates_.add_changed(scratch_, sent_classes_[index]);

@@ -82,6 +82,9 @@ class MapPublisher {
   void changed(const common::BlockIndex& index);
   // Writes what is due at `now`; returns the number of blocks written.
   std::size_t spin_once(common::Stamp now);
+  // When a round is due at `now`, writes its map_cloud_updates already, so that what the caller
+  // writes next (the costmap) goes out before the round's blocks; spin_once then skips them.
+  void spin_updates(common::Stamp now);
   // Writes all pending blocks now, regardless of the rate. A write timeout ends the round
   // early (counted); other DDS failures throw DdsError. Throws std::invalid_argument when the
   // source gives a block whose shape differs from the description.
@@ -122,6 +125,7 @@ class MapPublisher {
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> known_;
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
   bool info_dirty_ = true;
+  bool updates_due_ = false;  // blocks changed since the last map_cloud_updates
   common::Stamp next_blocks_;
   common::Stamp next_cloud_;
   MapPublisherCounters counters_;
