@@ -58,6 +58,58 @@ std::vector<V4l2FormatInfo> V4l2Device::formats() const {
   return out;
 }
 
+std::vector<V4l2FrameSize> V4l2Device::frame_sizes(std::uint32_t fourcc) const {
+  std::vector<V4l2FrameSize> out;
+  for (std::uint32_t index = 0;; ++index) {
+    v4l2_frmsizeenum size{};
+    size.index = index;
+    size.pixel_format = fourcc;
+    if (::ioctl(fd_, VIDIOC_ENUM_FRAMESIZES, &size) < 0) {
+      if (errno == EINVAL || errno == ENOTTY) break;  // end of the list, or not supported
+      throw_errno(path_ + ": VIDIOC_ENUM_FRAMESIZES");
+    }
+    if (size.type == V4L2_FRMSIZE_TYPE_DISCRETE) {
+      const auto& d = size.discrete;
+      out.push_back({d.width, d.width, 0, d.height, d.height, 0});
+    } else {  // stepwise or continuous (steps of 1): one entry, the range
+      const auto& s = size.stepwise;
+      out.push_back(
+          {s.min_width, s.max_width, s.step_width, s.min_height, s.max_height, s.step_height});
+      break;
+    }
+  }
+  return out;
+}
+
+std::vector<V4l2FrameInterval> V4l2Device::frame_intervals(std::uint32_t fourcc,
+                                                           std::uint32_t width,
+                                                           std::uint32_t height) const {
+  const auto seconds = [](const v4l2_fract& f) {
+    return f.denominator ? static_cast<double>(f.numerator) / f.denominator : 0.0;
+  };
+  std::vector<V4l2FrameInterval> out;
+  for (std::uint32_t index = 0;; ++index) {
+    v4l2_frmivalenum interval{};
+    interval.index = index;
+    interval.pixel_format = fourcc;
+    interval.width = width;
+    interval.height = height;
+    if (::ioctl(fd_, VIDIOC_ENUM_FRAMEINTERVALS, &interval) < 0) {
+      if (errno == EINVAL || errno == ENOTTY) break;
+      throw_errno(path_ + ": VIDIOC_ENUM_FRAMEINTERVALS");
+    }
+    if (interval.type == V4L2_FRMIVAL_TYPE_DISCRETE) {
+      const double s = seconds(interval.discrete);
+      out.push_back({s, s, 0.0});
+    } else {
+      const auto& w = interval.stepwise;
+      out.push_back({seconds(w.min), seconds(w.max), seconds(w.step)});
+      break;
+    }
+  }
+  return out;
+}
+
 V4l2Format V4l2Device::set_format(std::uint32_t fourcc, std::uint32_t width, std::uint32_t height) {
   v4l2_format fmt{};
   fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;

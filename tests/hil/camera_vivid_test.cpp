@@ -15,6 +15,7 @@
 #include "semap/drivers/frame_convert.hpp"
 #include "semap/drivers/jpeg_decoder.hpp"
 #include "semap/drivers/v4l2_device.hpp"
+#include "vivid.hpp"
 
 namespace semap::drivers {
 namespace {
@@ -23,20 +24,7 @@ using common::ImageFrame;
 using common::PixelFormat;
 using common::SpscRing;
 using namespace std::chrono_literals;
-
-// The first vivid video capture node, or "" when there is none.
-std::string find_vivid() {
-  for (int i = 0; i < 16; ++i) {
-    const std::string path = "/dev/video" + std::to_string(i);
-    try {
-      V4l2Device dev(path);
-      if (dev.driver() == "vivid") return path;
-    } catch (const DriverError&) {
-      // not a capture node, or no such device
-    }
-  }
-  return "";
-}
+using hil::find_vivid;
 
 class VividTest : public ::testing::Test {
  protected:

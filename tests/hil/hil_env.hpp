@@ -4,7 +4,10 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -25,6 +28,24 @@ inline bool wait_until(const std::function<bool()>& done, std::chrono::milliseco
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   return true;
+}
+
+// A program given to scripts/hil-qemu (--payload) sits next to the test binary; natively it is
+// where the build put it (`built`). "" when neither exists.
+inline std::string find_program(const std::string& name, const std::string& built) {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec && std::filesystem::exists(self.parent_path() / name)) {
+    return (self.parent_path() / name).string();
+  }
+  return std::filesystem::exists(built) ? built : "";
+}
+
+inline std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 }  // namespace semap::hil

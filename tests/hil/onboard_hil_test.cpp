@@ -27,29 +27,19 @@
 #include "semap/drivers/driver_error.hpp"
 #include "semap/drivers/v4l2_device.hpp"
 #include "support/onnx_writer.hpp"
+#include "vivid.hpp"
 
 namespace semap::drivers {
 namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
+using hil::find_program;
+using hil::find_vivid;
+using hil::read_file;
 
 constexpr double kRunSeconds = 20.0;       // semap-onboard --duration
 constexpr double kPipelineSeconds = 30.0;  // the simulated rig's drive
-
-// The first vivid video capture node, or "" when there is none.
-std::string find_vivid() {
-  for (int i = 0; i < 16; ++i) {
-    const std::string path = "/dev/video" + std::to_string(i);
-    try {
-      V4l2Device dev(path);
-      if (dev.driver() == "vivid") return path;
-    } catch (const DriverError&) {
-      // not a capture node, or no such device
-    }
-  }
-  return "";
-}
 
 // The video output node of the vivid instance whose capture node is `capture`, or "".
 std::string find_vivid_output(const std::string& capture) {
@@ -73,21 +63,6 @@ std::string find_vivid_output(const std::string& capture) {
     if (bus(path, V4L2_CAP_VIDEO_OUTPUT) == instance) return path;
   }
   return "";
-}
-
-// A program given to scripts/hil-qemu sits next to this binary; natively it is in the build tree.
-std::string find_program(const std::string& name, const std::string& built) {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec && fs::exists(self.parent_path() / name)) return (self.parent_path() / name).string();
-  return fs::exists(built) ? built : "";
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 fs::path write_file(const fs::path& path, const std::string& text) {

@@ -15,6 +15,19 @@ struct V4l2FormatInfo {
   std::string description;
 };
 
+// A frame size a format offers: one size (discrete), or every size from min to max in steps.
+struct V4l2FrameSize {
+  std::uint32_t min_width = 0, max_width = 0, step_width = 0;
+  std::uint32_t min_height = 0, max_height = 0, step_height = 0;
+  bool discrete() const { return min_width == max_width && min_height == max_height; }
+};
+
+// A frame interval (seconds per frame) a format and size offer: one, or a range in steps.
+struct V4l2FrameInterval {
+  double min_s = 0, max_s = 0, step_s = 0;
+  bool discrete() const { return min_s == max_s; }
+};
+
 struct V4l2Format {
   std::uint32_t fourcc = 0;
   std::uint32_t width = 0;
@@ -47,6 +60,10 @@ class V4l2Device {
   const std::string& driver() const { return driver_; }
 
   std::vector<V4l2FormatInfo> formats() const;  // VIDIOC_ENUM_FMT
+  // VIDIOC_ENUM_FRAMESIZES / VIDIOC_ENUM_FRAMEINTERVALS; empty when the driver does not say.
+  std::vector<V4l2FrameSize> frame_sizes(std::uint32_t fourcc) const;
+  std::vector<V4l2FrameInterval> frame_intervals(std::uint32_t fourcc, std::uint32_t width,
+                                                 std::uint32_t height) const;
   // VIDIOC_S_FMT; the device may adjust the size, so the result says what was set. Throws
   // when the device substitutes another pixel format.
   V4l2Format set_format(std::uint32_t fourcc, std::uint32_t width, std::uint32_t height);
