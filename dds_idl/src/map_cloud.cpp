@@ -99,8 +99,9 @@ std::vector<CloudPoint> read_map_cloud(const msg::PointCloud2& m) {
     }
   }
   const std::size_t n = static_cast<std::size_t>(m.width_) * m.height_;
+  // Divided, not multiplied: width * height * point_step may wrap.
   if (m.is_bigendian_ || m.point_step_ != MapCloud::kPointStep ||
-      m.data_._length != n * MapCloud::kPointStep) {
+      m.data_._length % MapCloud::kPointStep != 0 || m.data_._length / MapCloud::kPointStep != n) {
     throw std::runtime_error("PointCloud2: point_step/data length/endianness mismatch");
   }
   std::vector<CloudPoint> out(n);

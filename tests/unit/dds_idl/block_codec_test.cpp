@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/map_cloud.hpp"
@@ -189,6 +190,57 @@ TEST(MapCloud, ReadsBackWhatItWrote) {
   msg::PointCloud2 wrong = cloud.message(common::Stamp(5));
   wrong.point_step_ = 16;
   EXPECT_THROW(read_map_cloud(wrong), std::runtime_error);
+  // 2^61 points: 2^61 * 24 = 3 * 2^64 wraps to 0, the length of empty data. Refused, not read.
+  msg::PointCloud2 wrapping = cloud.message(common::Stamp(5));
+  wrapping.width_ = 0x80000000u;
+  wrapping.height_ = 0x40000000u;
+  wrapping.data_._length = 0;
+  EXPECT_THROW(read_map_cloud(wrapping), std::runtime_error);
+}
+
+// map_cloud_updates' content: each cell whose occupancy or class changed, once; freed cells
+// with kRemovedClass.
+TEST(MapCloud, ChangedCellsSinceTheLastUpdate) {
+  BlockSnapshot b = sample_block(false);
+  std::vector<std::uint16_t> sent;
+  MapCloud first("map", {});
+  first.add_changed(b, sent);
+  std::size_t occupied = 0;
+  for (const auto s : b.state) occupied += s == common::CellState::kOccupied;
+  ASSERT_GT(occupied, 2u);
+  EXPECT_EQ(first.size(), occupied) << "nothing sent yet: every occupied cell";
+
+  MapCloud again("map", {});
+  again.add_changed(b, sent);
+  EXPECT_EQ(again.size(), 0u) << "unchanged block: no cell";
+
+  // One occupied cell relabelled, one freed, one unknown cell now occupied, one variance only.
+  std::vector<std::size_t> occ;
+  std::size_t unknown = b.cell_count();
+  for (std::size_t i = 0; i < b.cell_count(); ++i) {
+    if (b.state[i] == common::CellState::kOccupied) occ.push_back(i);
+    if (b.state[i] == common::CellState::kUnknown && unknown == b.cell_count()) unknown = i;
+  }
+  ASSERT_LT(unknown, b.cell_count());
+  b.argmax_class[occ[0]] = static_cast<std::uint16_t>(b.argmax_class[occ[0]] == 1 ? 2 : 1);
+  b.state[occ[1]] = common::CellState::kFree;
+  b.state[unknown] = common::CellState::kOccupied;
+  b.argmax_class[unknown] = 2;
+  b.variance[occ[2]] += 0.01f;
+  MapCloud update("map", {});
+  update.add_changed(b, sent);
+  const auto points = read_map_cloud(update.message(common::Stamp(6)));
+  ASSERT_EQ(points.size(), 3u);
+  std::map<std::size_t, std::uint16_t> by_cell;
+  for (const auto& p : points) {
+    for (const std::size_t c : {occ[0], occ[1], unknown}) {
+      if (p.position.isApprox(b.cell_center(c))) by_cell[c] = p.cls;
+    }
+  }
+  ASSERT_EQ(by_cell.size(), 3u);
+  EXPECT_EQ(by_cell[occ[0]], b.argmax_class[occ[0]]);
+  EXPECT_EQ(by_cell[occ[1]], MapCloud::kRemovedClass);
+  EXPECT_EQ(by_cell[unknown], 2);
 }
 
 TEST(MapInfo, RoundTripAndInconsistentInfoIsRefused) {
