@@ -54,6 +54,7 @@ double json_number(const std::string& json, const std::string& key) {
 TEST_F(CameraToolHil, ListsWhatTheDeviceEnumerates) {
   std::string out;
   ASSERT_EQ(run("--list", out), 0) << out;
+  std::printf("%s", out.c_str());  // the listing, for the log
   EXPECT_NE(out.find(device_ + ": "), std::string::npos) << out;
   EXPECT_NE(out.find("(vivid)"), std::string::npos) << out;
   // Every format, size and interval the device gives for YUYV appears as v4l2-ctl prints it.
@@ -89,6 +90,7 @@ TEST_F(CameraToolHil, GrabsFramesAsPngAndMeasuresTheRate) {
                 out),
             0)
       << out;
+  std::printf("%s", out.c_str());
   EXPECT_EQ(json_number(out, "frames"), 20) << out;
   EXPECT_EQ(json_number(out, "png_written"), 20) << out;
   EXPECT_EQ(json_number(out, "width"), 640);
