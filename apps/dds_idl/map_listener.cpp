@@ -26,7 +26,9 @@ void print_health(const sd::HealthReport& h) {
   }
   for (const auto& d : h.drivers) {
     std::cout << " driver " << d.name << " frames " << d.frames << " bad " << d.bad_frames
-              << " dropped " << d.dropped << " reconnects " << d.reconnects << " |";
+              << " dropped " << d.dropped << " reconnects " << d.reconnects << " bus_off "
+              << d.bus_off << " error_passive " << d.error_passive << " bus_restarts "
+              << d.bus_restarts << " |";
   }
   std::cout << std::endl;
 }

@@ -30,8 +30,14 @@ dds_idl::HealthReport HealthMonitor::report(common::Stamp now,
 }
 
 dds_idl::DriverCountersData driver_health(const std::string& name, const drivers::DriverStats& s) {
-  return {name, s.frames, s.checksum_failures + s.errors,
-          s.input_drops + s.sequence_gaps + s.ring_drops, s.reconnects};
+  return {name,
+          s.frames,
+          s.checksum_failures + s.errors,
+          s.input_drops + s.sequence_gaps + s.ring_drops,
+          s.reconnects,
+          s.bus_off,
+          s.error_passive,
+          s.bus_restarts};
 }
 
 }  // namespace semap::onboard

@@ -352,8 +352,11 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   }
   if (imu_driver) {
     const auto i = imu_driver->stats();
-    std::printf("imu driver       : %lu samples, %lu CRC failures, %lu gaps, %lu reconnects\n",
-                i.frames, i.checksum_failures, i.sequence_gaps, i.reconnects);
+    std::printf(
+        "imu driver       : %lu samples, %lu CRC failures, %lu gaps, %lu reconnects, %lu bus-off "
+        "(%lu restarts), %lu error-passive\n",
+        i.frames, i.checksum_failures, i.sequence_gaps, i.reconnects, i.bus_off, i.bus_restarts,
+        i.error_passive);
   }
   std::printf(
       "estimation       : %lu IMU samples, %lu GNSS fixes (%lu applied, %lu gated out), "

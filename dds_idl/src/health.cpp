@@ -10,8 +10,8 @@ HealthMessage::HealthMessage(const HealthReport& r, const std::string& frame_id)
                        s.latency_p50_ms, s.latency_p99_ms});
   }
   for (const auto& d : r.drivers) {
-    drivers_.push_back(
-        {const_cast<char*>(d.name.c_str()), d.frames, d.bad_frames, d.dropped, d.reconnects});
+    drivers_.push_back({const_cast<char*>(d.name.c_str()), d.frames, d.bad_frames, d.dropped,
+                        d.reconnects, d.bus_off, d.error_passive, d.bus_restarts});
   }
   msg_.header_.stamp_ = to_msg_time(r.stamp);
   msg_.header_.frame_id_ = const_cast<char*>(frame_id.c_str());
@@ -31,8 +31,8 @@ HealthReport from_msg(const msg::Health& m) {
   }
   for (std::uint32_t i = 0; i < m.drivers_._length; ++i) {
     const auto& d = m.drivers_._buffer[i];
-    r.drivers.push_back(
-        {d.name_ ? d.name_ : "", d.frames_, d.bad_frames_, d.dropped_, d.reconnects_});
+    r.drivers.push_back({d.name_ ? d.name_ : "", d.frames_, d.bad_frames_, d.dropped_,
+                         d.reconnects_, d.bus_off_, d.error_passive_, d.bus_restarts_});
   }
   return r;
 }

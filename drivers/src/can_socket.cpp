@@ -1,9 +1,7 @@
 #include "semap/drivers/can_socket.hpp"
 
-#include <libsocketcan.h>
 #include <linux/can.h>
 #include <linux/can/error.h>
-#include <linux/can/netlink.h>
 #include <linux/can/raw.h>
 #include <linux/errqueue.h>
 #include <linux/net_tstamp.h>
@@ -17,27 +15,12 @@
 #include <cerrno>
 #include <cstring>
 #include <ctime>
-#include <filesystem>
 #include <vector>
 
 #include "semap/drivers/driver_error.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
 
 namespace semap::drivers {
-namespace {
-
-// libsocketcan reports controller state for real CAN hardware. Virtual interfaces (vcan) have
-// no parent device and no state; asking would only make libsocketcan print an error.
-void throw_if_bus_off(const std::string& interface) {
-  std::error_code ec;
-  if (!std::filesystem::exists("/sys/class/net/" + interface + "/device", ec)) return;
-  int state = 0;
-  if (::can_get_state(interface.c_str(), &state) == 0 && state == CAN_STATE_BUS_OFF) {
-    throw DriverError(interface + ": controller is bus-off", ENETDOWN);
-  }
-}
-
-}  // namespace
 
 bool interface_is_up(const std::string& interface) {
   const int s = ::socket(AF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
@@ -57,7 +40,6 @@ CanSocket::CanSocket(const std::string& interface,
   const unsigned int index = ::if_nametoindex(interface.c_str());
   if (index == 0) throw_errno("CAN interface " + interface);
   if (!interface_is_up(interface)) throw DriverError(interface + ": interface is down", ENETDOWN);
-  throw_if_bus_off(interface);
 
   fd_ = ::socket(AF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
   if (fd_ < 0) throw_errno("socket(AF_CAN)");
@@ -74,7 +56,9 @@ CanSocket::CanSocket(const std::string& interface,
                      static_cast<socklen_t>(kernel_filters.size() * sizeof(can_filter))) < 0) {
       throw_errno(interface + ": CAN_RAW_FILTER");
     }
-    const can_err_mask_t err_mask = CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
+    // State changes (warning, passive, active) come as CAN_ERR_CRTL; bus errors are left out:
+    // with berr-reporting on they arrive per faulty frame and say nothing the states do not.
+    const can_err_mask_t err_mask = CAN_ERR_BUSOFF | CAN_ERR_RESTARTED | CAN_ERR_CRTL;
     if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof(err_mask)) < 0) {
       throw_errno(interface + ": CAN_RAW_ERR_FILTER");
     }
@@ -138,26 +122,35 @@ CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {
   if (got != static_cast<ssize_t>(CAN_MTU) && got != static_cast<ssize_t>(CANFD_MTU)) {
     throw DriverError(interface_ + ": short CAN read", EIO);
   }
+  CanRead kind = CanRead::kFrame;
   if (raw.can_id & CAN_ERR_FLAG) {
-    if (raw.can_id & CAN_ERR_BUSOFF) throw DriverError(interface_ + ": bus-off", ENETDOWN);
-    return CanRead::kTimeout;  // restarted: nothing to deliver
-  }
-  if (!firmware_bridge::from_kernel_frame(&raw, static_cast<std::size_t>(got), frame.frame)) {
+    can_frame error{};
+    std::memcpy(&error, &raw, sizeof(error));
+    frame.error = classify_error_frame(error);
+    frame.frame = SemapCanFrame{};
+    frame.frame.id = raw.can_id & CAN_ERR_MASK;
+    frame.frame.len = CAN_ERR_DLC;
+    std::memcpy(frame.frame.data, raw.data, CAN_ERR_DLC);
+    kind = CanRead::kError;
+  } else if (!firmware_bridge::from_kernel_frame(&raw, static_cast<std::size_t>(got),
+                                                 frame.frame)) {
     return CanRead::kTimeout;  // remote frame: not part of any protocol we decode
   }
   frame.stamp = common::Stamp::now();
+  frame.realtime_ns = clock_.to_realtime(frame.stamp);
   for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPING) {
       scm_timestamping ts{};
       std::memcpy(&ts, CMSG_DATA(c), sizeof(ts));
       if (ts.ts[0].tv_sec != 0 || ts.ts[0].tv_nsec != 0) {
-        frame.stamp = clock_.to_monotonic(common::Stamp::from_timespec(ts.ts[0]).ns);
+        frame.realtime_ns = common::Stamp::from_timespec(ts.ts[0]).ns;
+        frame.stamp = clock_.to_monotonic(frame.realtime_ns);
       }
     } else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
       std::memcpy(&frame.kernel_drops, CMSG_DATA(c), sizeof(frame.kernel_drops));
     }
   }
-  return CanRead::kFrame;
+  return kind;
 }
 
 }  // namespace semap::drivers

@@ -1,5 +1,7 @@
 // CanImuDriver against the firmware emulator on a real vcan0: natively where the host kernel
 // can create vcan0, otherwise inside scripts/hil-qemu (see docs/hil.md).
+#include <linux/can.h>
+#include <linux/can/error.h>
 #include <net/if.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
@@ -52,6 +54,16 @@ bool ensure_vcan() {
     if (std::system(cmd.c_str()) != 0 || ::if_nametoindex(kInterface) == 0) return false;
   }
   return set_link_up(kInterface, true);
+}
+
+// Writes an error frame as a CAN controller driver does (vcan passes it to every socket whose
+// CAN_RAW_ERR_FILTER asks for its class).
+bool send_error_frame(int fd, canid_t error_class, std::uint8_t controller = 0) {
+  can_frame f{};
+  f.can_id = CAN_ERR_FLAG | error_class;
+  f.len = CAN_ERR_DLC;
+  f.data[1] = controller;
+  return ::write(fd, &f, sizeof f) == static_cast<ssize_t>(sizeof f);
 }
 
 struct Received {
@@ -313,6 +325,81 @@ TEST_F(VcanTest, ResumesAfterInterfaceDownAndUp) {
   EXPECT_EQ(got.back().sequence, 1199u);
   EXPECT_EQ(got.back().sequence - got.front().sequence + 1, got.size() + c.missed_samples);
   EXPECT_EQ(c.crc_errors, 0u);
+}
+
+// Controller trouble as error frames: error-passive and back, bus-off ended by the kernel's
+// "restarted" frame (what restart-ms or can_do_restart produce), and bus-off ended by traffic
+// alone. Each is counted, the socket stays open throughout (no reconnect), and every sample
+// sent around the episodes arrives.
+TEST_F(VcanTest, ErrorFramesAreCountedAndBusOffRecoversWithoutReconnecting) {
+  SpscRing<ImuSample> ring(4096, common::OverflowPolicy::kDropOldest);
+  CanImuDriver driver(config(), ring);
+  driver.start();
+  ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
+  start_consumer(ring);
+
+  firmware_bridge::CanSocket tx(kInterface, false);
+  firmware_bridge::CanSocket errors(kInterface, false);
+  firmware_bridge::Emulator emulator(emulator_config(tx.fd(), 1.0));
+  std::uint64_t sent = 0;
+  const auto send_samples = [&](int n) {
+    for (int i = 0; i < n; ++i) {
+      ImuSample s;
+      s.stamp = common::Stamp::now();
+      s.accel = Eigen::Vector3d(0.0, 0.0, 9.81);
+      emulator.emit(s);
+      ++sent;
+      std::this_thread::sleep_for(2500us);
+    }
+  };
+  const auto stats = [&] { return driver.stats(); };
+
+  send_samples(200);
+  ASSERT_TRUE(send_error_frame(errors.fd(), CAN_ERR_CRTL | CAN_ERR_CNT, CAN_ERR_CRTL_RX_PASSIVE));
+  EXPECT_TRUE(hil::wait_until([&] { return stats().error_passive == 1; }, 2s));
+  EXPECT_EQ(driver.bus_state(), CanBusState::kErrorPassive);
+  send_samples(50);  // an error-passive node still receives
+  ASSERT_TRUE(send_error_frame(errors.fd(), CAN_ERR_CRTL, CAN_ERR_CRTL_ACTIVE));
+  EXPECT_TRUE(hil::wait_until([&] { return driver.bus_state() == CanBusState::kErrorActive; }, 2s));
+
+  // Bus-off, then the kernel's restart frame.
+  ASSERT_TRUE(send_error_frame(errors.fd(), CAN_ERR_BUSOFF));
+  EXPECT_TRUE(hil::wait_until([&] { return stats().bus_off == 1; }, 2s));
+  EXPECT_EQ(driver.bus_state(), CanBusState::kBusOff);
+  ASSERT_TRUE(send_error_frame(errors.fd(), CAN_ERR_RESTARTED));
+  EXPECT_TRUE(hil::wait_until([&] { return stats().bus_restarts == 1; }, 2s));
+  EXPECT_EQ(driver.bus_state(), CanBusState::kErrorActive);
+  send_samples(100);
+
+  // Bus-off again, ended by frames arriving: a bus-off controller receives none.
+  ASSERT_TRUE(send_error_frame(errors.fd(), CAN_ERR_BUSOFF));
+  EXPECT_TRUE(hil::wait_until([&] { return stats().bus_off == 2; }, 2s));
+  EXPECT_EQ(driver.bus_state(), CanBusState::kBusOff);
+  send_samples(150);
+  EXPECT_TRUE(hil::wait_until([&] { return stats().frames >= sent; }, 5s));
+  driver.stop();
+  stop_consumer();
+
+  const DriverStats st = driver.stats();
+  const auto c = driver.imu_counters();
+  std::printf(
+      "vcan error frames: sent %llu samples, received %zu; error-passive %llu, bus-off %llu, "
+      "restarts %llu, reconnects %llu, missed %llu, last error '%s'\n",
+      (unsigned long long)sent, received_.samples.size(), (unsigned long long)st.error_passive,
+      (unsigned long long)st.bus_off, (unsigned long long)st.bus_restarts,
+      (unsigned long long)st.reconnects, (unsigned long long)c.missed_samples,
+      driver.last_error().c_str());
+  EXPECT_EQ(st.error_passive, 1u);
+  EXPECT_EQ(st.bus_off, 2u);
+  EXPECT_EQ(st.bus_restarts, 2u);
+  EXPECT_EQ(driver.bus_state(), CanBusState::kErrorActive);
+  EXPECT_EQ(st.reconnects, 0u);
+  EXPECT_EQ(driver.failures(), 0u);
+  EXPECT_NE(driver.last_error().find("vcan0: controller is bus-off"), std::string::npos)
+      << driver.last_error();
+  EXPECT_EQ(received_.samples.size(), sent);
+  EXPECT_EQ(c.missed_samples, 0u);
+  EXPECT_EQ(c.crc_errors + c.bad_frames + c.incomplete + c.unknown, 0u);
 }
 
 }  // namespace

@@ -60,12 +60,18 @@ TEST(HealthMonitor, DriverCountersSumIntegrityAndLosses) {
   s.sequence_gaps = 4;
   s.ring_drops = 5;
   s.reconnects = 1;
+  s.bus_off = 6;
+  s.error_passive = 7;
+  s.bus_restarts = 8;
   const auto d = driver_health("imu", s);
   EXPECT_EQ(d.name, "imu");
   EXPECT_EQ(d.frames, 50u);
   EXPECT_EQ(d.bad_frames, 3u);
   EXPECT_EQ(d.dropped, 12u);
   EXPECT_EQ(d.reconnects, 1u);
+  EXPECT_EQ(d.bus_off, 6u);
+  EXPECT_EQ(d.error_passive, 7u);
+  EXPECT_EQ(d.bus_restarts, 8u);
 }
 
 }  // namespace

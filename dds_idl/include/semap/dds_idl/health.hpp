@@ -25,6 +25,10 @@ struct DriverCountersData {
   std::uint64_t bad_frames = 0;
   std::uint64_t dropped = 0;
   std::uint64_t reconnects = 0;
+  // CAN drivers: entries into bus-off and error-passive, recoveries from bus-off.
+  std::uint64_t bus_off = 0;
+  std::uint64_t error_passive = 0;
+  std::uint64_t bus_restarts = 0;
 };
 
 struct HealthReport {

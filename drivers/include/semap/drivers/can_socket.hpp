@@ -6,25 +6,29 @@
 
 #include "semap/common/clock_offset.hpp"
 #include "semap/common/stamp.hpp"
+#include "semap/drivers/can_bus_state.hpp"
 #include "semap/firmware_bridge/can_frame.h"
 #include "semap/firmware_bridge/can_imu_decoder.hpp"
 
 namespace semap::drivers {
 
-// One received CAN or CAN FD frame with its kernel receive time.
+// One received CAN or CAN FD frame, or error frame, with its kernel receive time.
 struct CanRxFrame {
+  // For an error frame: the error class bits (CAN_ERR_MASK) in `id` and the 8 detail bytes.
   SemapCanFrame frame{};
-  common::Stamp stamp;  // kernel RX software timestamp, mapped onto CLOCK_MONOTONIC
+  CanErrorReport error;          // what an error frame says (kError only)
+  common::Stamp stamp;           // kernel RX software timestamp, mapped onto CLOCK_MONOTONIC
+  std::int64_t realtime_ns = 0;  // the same instant on CLOCK_REALTIME, as candump logs it
   // Frames the kernel dropped on this socket so far because its queue was full (SO_RXQ_OVFL).
   std::uint32_t kernel_drops = 0;
 };
 
-enum class CanRead : std::uint8_t { kFrame, kTimeout };
+enum class CanRead : std::uint8_t { kFrame, kError, kTimeout };
 
 // A CAN_RAW socket bound to one interface with kernel filters and SO_TIMESTAMPING. Throws
-// DriverError with ENETDOWN when the interface is down (also while open), ENODEV when it is
-// gone, and reports bus-off (error frames) the same way, so the driver's reconnect loop covers
-// all of them.
+// DriverError with ENETDOWN when the interface is down (also while open) and ENODEV when it is
+// gone, so the driver's reconnect loop covers both. Error frames for controller state changes,
+// bus-off and restarts come back as kError: the socket stays usable through bus-off.
 class CanSocket {
  public:
   // `receive_buffer` sizes the kernel queue (SO_RCVBUF[FORCE]); a CAN frame costs about 1 KiB

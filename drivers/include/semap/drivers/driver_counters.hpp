@@ -15,6 +15,9 @@ struct DriverStats {
   std::uint64_t input_drops = 0;        // messages the kernel dropped before we read them
   std::uint64_t reconnects = 0;         // successful reopenings after a failure
   std::uint64_t errors = 0;             // other rejected input (malformed, unexpected)
+  std::uint64_t bus_off = 0;            // CAN: times the controller went bus-off
+  std::uint64_t error_passive = 0;      // CAN: times the controller went error-passive
+  std::uint64_t bus_restarts = 0;       // CAN: recoveries from bus-off (restarted, back on the bus)
 };
 
 // Written by the driver thread only, read from any thread. Single writer, so a relaxed load
@@ -29,6 +32,9 @@ class DriverCounters {
   void add_input_drop(std::uint64_t n) { bump(input_drops_, n); }
   void add_reconnect() { bump(reconnects_, 1); }
   void add_error(std::uint64_t n = 1) { bump(errors_, n); }
+  void add_bus_off() { bump(bus_off_, 1); }
+  void add_error_passive() { bump(error_passive_, 1); }
+  void add_bus_restart() { bump(bus_restarts_, 1); }
 
   DriverStats snapshot() const {
     DriverStats s;
@@ -40,6 +46,9 @@ class DriverCounters {
     s.input_drops = input_drops_.load(std::memory_order_acquire);
     s.reconnects = reconnects_.load(std::memory_order_acquire);
     s.errors = errors_.load(std::memory_order_acquire);
+    s.bus_off = bus_off_.load(std::memory_order_acquire);
+    s.error_passive = error_passive_.load(std::memory_order_acquire);
+    s.bus_restarts = bus_restarts_.load(std::memory_order_acquire);
     return s;
   }
 
@@ -56,6 +65,9 @@ class DriverCounters {
   std::atomic<std::uint64_t> input_drops_{0};
   std::atomic<std::uint64_t> reconnects_{0};
   std::atomic<std::uint64_t> errors_{0};
+  std::atomic<std::uint64_t> bus_off_{0};
+  std::atomic<std::uint64_t> error_passive_{0};
+  std::atomic<std::uint64_t> bus_restarts_{0};
 };
 
 }  // namespace semap::drivers
