@@ -46,11 +46,11 @@ void read_rig(const ConfigSection& s, RigConfig& rig) {
 }
 
 void read_imu(const ConfigSection& s, ImuSourceConfig& imu) {
+  // The driver's keys (profile, base_id, j1939_source, fd_frames, restart_bus_off, reconnect_*)
+  // as the driver documents them; an empty interface means no CAN (the simulated rig's ring).
+  imu.driver = drivers::can_imu_config(s);
   imu.interface = s.get<std::string>("interface", "");
   imu.driver.interface = imu.interface;
-  const std::string profile = s.get_choice("profile", "semap", {"semap", "j1939"});
-  imu.driver.decoder.profile = profile == "j1939" ? firmware_bridge::ImuProfile::kJ1939
-                                                  : firmware_bridge::ImuProfile::kSemap;
   imu.ring = static_cast<std::size_t>(s.get_in_range("ring", 4096, 16, 1 << 20));
   s.finish();
 }

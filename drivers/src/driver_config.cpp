@@ -30,9 +30,12 @@ CanImuConfig can_imu_config(const common::ConfigSection& imu) {
                                          : firmware_bridge::ImuProfile::kJ1939;
   c.decoder.base_id = static_cast<std::uint32_t>(
       get_int(imu, "base_id", static_cast<int>(c.decoder.base_id), 0, 0x7FC));
-  c.decoder.j1939_source = static_cast<std::uint16_t>(
-      get_int(imu, "j1939_source", c.decoder.j1939_source, 0, SEMAP_J1939_ADDRESS_ANY));
+  // A J1939 node claims 0..253 (254 is the null address, 255 the global destination).
+  if (imu.has("j1939_source") && imu.get<std::string>("j1939_source") != "any") {
+    c.decoder.j1939_source = static_cast<std::uint16_t>(get_int(imu, "j1939_source", 0, 0, 253));
+  }
   c.fd_frames = imu.get<bool>("fd_frames", c.fd_frames);
+  c.restart_bus_off = imu.get<bool>("restart_bus_off", c.restart_bus_off);
   c.backoff = backoff(imu);
   return c;
 }

@@ -53,5 +53,29 @@ TEST(DriverConfig, RejectsBadValuesNamingTheFile) {
   EXPECT_THROW(can_imu_config(bad_profile.section("imu")), ConfigError);
 }
 
+TEST(DriverConfig, J1939SourceIsAClaimableAddressOrAny) {
+  const auto source = [](const std::string& value) {
+    const auto root =
+        ConfigSection::load_string("imu: { j1939_source: " + value + " }\n", "i.yaml");
+    return can_imu_config(root.section("imu")).decoder.j1939_source;
+  };
+  EXPECT_EQ(source("0"), 0);
+  EXPECT_EQ(source("253"), 253);
+  EXPECT_EQ(source("any"), SEMAP_J1939_ADDRESS_ANY);
+  EXPECT_EQ(
+      can_imu_config(ConfigSection::load_string("imu: {}\n").section("imu")).decoder.j1939_source,
+      SEMAP_J1939_ADDRESS_ANY);
+  EXPECT_THROW(source("254"), ConfigError);  // null address: no node sends from it
+  EXPECT_THROW(source("255"), ConfigError);  // global: a destination only
+  EXPECT_THROW(source("some"), ConfigError);
+}
+
+TEST(DriverConfig, BusOffRestartCanBeLeftToTheSystem) {
+  const auto on = ConfigSection::load_string("imu: { interface: can0 }\n");
+  EXPECT_TRUE(can_imu_config(on.section("imu")).restart_bus_off);
+  const auto off = ConfigSection::load_string("imu: { restart_bus_off: false }\n");
+  EXPECT_FALSE(can_imu_config(off.section("imu")).restart_bus_off);
+}
+
 }  // namespace
 }  // namespace semap::drivers

@@ -140,5 +140,47 @@ TEST(J1939, DecoderPairsRateAndAccelerationIntoFluSample) {
   EXPECT_NE(other_source.id & filter.mask, filter.id & filter.mask);
 }
 
+// J1939 IMUs send ARI/ACCS at priority 2, 3 or 6 depending on the vendor, and a tool may sit at
+// any address: every priority passes the kernel filter and decodes, from one source or any.
+TEST(J1939, AnyPriorityFromTheConfiguredSourceOrAny) {
+  SemapJ1939AngularRate rate{};
+  rate.yaw_dps = 5.0;
+  SemapJ1939Acceleration acc{};
+  acc.vertical_mps2 = 9.81;
+  for (const std::uint16_t source : {std::uint16_t{0x80}, std::uint16_t{SEMAP_J1939_ADDRESS_ANY}}) {
+    CanImuDecoderConfig config;
+    config.profile = ImuProfile::kJ1939;
+    config.j1939_source = source;
+    CanImuDecoder decoder(config);
+    const CanIdFilter filter = decoder.filter();
+    int samples = 0;
+    for (std::uint8_t priority = 0; priority <= 7; ++priority) {
+      SCOPED_TRACE(priority);
+      SemapCanFrame fr;
+      SemapCanFrame fa;
+      semap_j1939_encode_angular_rate(&rate, priority, 0x80, &fr);
+      semap_j1939_encode_acceleration(&acc, priority, 0x80, &fa);
+      EXPECT_EQ(semap_j1939_parse_id(fr.id).priority, priority);
+      EXPECT_EQ(fr.id & filter.mask, filter.id & filter.mask);
+      EXPECT_EQ(fa.id & filter.mask, filter.id & filter.mask);
+      EXPECT_FALSE(decoder.push(fr, common::Stamp(priority)));
+      const auto sample = decoder.push(fa, common::Stamp(priority));
+      ASSERT_TRUE(sample);
+      EXPECT_NEAR(sample->accel.z(), 9.81, 0.006);
+      ++samples;
+    }
+    EXPECT_EQ(samples, 8);
+    // Another source: rejected by filter and decoder with a configured one, taken with any.
+    SemapCanFrame fr;
+    SemapCanFrame fa;
+    semap_j1939_encode_angular_rate(&rate, 6, 0x2A, &fr);
+    semap_j1939_encode_acceleration(&acc, 6, 0x2A, &fa);
+    const bool any = source == SEMAP_J1939_ADDRESS_ANY;
+    EXPECT_EQ((fr.id & filter.mask) == (filter.id & filter.mask), any);
+    decoder.push(fr, common::Stamp(10));
+    EXPECT_EQ(decoder.push(fa, common::Stamp(11)).has_value(), any);
+  }
+}
+
 }  // namespace
 }  // namespace semap::firmware_bridge

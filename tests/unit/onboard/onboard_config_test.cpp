@@ -103,6 +103,24 @@ TEST(OnboardConfig, MapPaletteNamesTheClassesInMapInfo) {
   EXPECT_EQ(d.class_colors[1], 0x804080u);
 }
 
+TEST(OnboardConfig, ImuTakesEveryDriverKey) {
+  const auto defaults = load_onboard_config(kConfigDir / "sim.yaml");
+  EXPECT_EQ(defaults.imu.driver.decoder.j1939_source, SEMAP_J1939_ADDRESS_ANY);
+  EXPECT_TRUE(defaults.imu.driver.restart_bus_off);
+  const auto path = edited_sim(
+      "  profile: semap",
+      "  profile: j1939\n  j1939_source: 42\n  restart_bus_off: false\n  reconnect_min_ms: 20");
+  const auto c = load_onboard_config(path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(c.imu.driver.decoder.profile, firmware_bridge::ImuProfile::kJ1939);
+  EXPECT_EQ(c.imu.driver.decoder.j1939_source, 42);
+  EXPECT_FALSE(c.imu.driver.restart_bus_off);
+  EXPECT_EQ(c.imu.driver.backoff.initial.count(), 20);
+  const std::string bad =
+      error_of(edited_sim("  profile: semap", "  profile: j1939\n  j1939_source: 255"));
+  EXPECT_NE(bad.find("j1939_source"), std::string::npos) << bad;
+}
+
 TEST(OnboardConfig, MapCheckpointAndMemoryRadius) {
   const auto c = load_onboard_config(kConfigDir / "sim.yaml");
   EXPECT_DOUBLE_EQ(c.map.checkpoint_s, 10.0);

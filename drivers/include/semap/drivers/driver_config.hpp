@@ -10,7 +10,8 @@ namespace semap::drivers {
 // Readers for the driver keys of the onboard config (docs/drivers.md). They read only their own
 // keys, so the caller can read the rest of the section (ring sizes, lever arm, intrinsics) and
 // then call finish() to reject typos. Bad values throw common::ConfigError naming file:line.
-//   imu:    interface, profile (semap|j1939), base_id, j1939_source, fd_frames
+//   imu:    interface, profile (semap|j1939), base_id, j1939_source (0..253|any), fd_frames,
+//           restart_bus_off
 //   gnss:   device, baud, vmin, vtime, uere_m
 //   camera: device, format (YUYV|MJPEG|GREY|Z16), width, height, fps, buffers
 //   all:    reconnect_min_ms, reconnect_max_ms
