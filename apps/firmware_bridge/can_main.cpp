@@ -45,6 +45,7 @@ struct InputCounters {
   std::uint64_t bus_off = 0;
   std::uint64_t error_passive = 0;
   std::uint64_t restarted = 0;
+  std::uint64_t bus_errors = 0;  // protocol, ACK, arbitration, transceiver, overflow
 };
 
 // Sample and event times are CLOCK_REALTIME, as candump logs them.
@@ -74,6 +75,7 @@ void handle_error_frame(const SemapCanFrame& frame, Stamp stamp, bool json, Inpu
   kernel.len = frame.len;
   std::memcpy(kernel.data, frame.data, frame.len < CAN_MAX_DLEN ? frame.len : CAN_MAX_DLEN);
   const dr::CanErrorReport report = dr::classify_error_frame(kernel);
+  if (report.bus_error) ++c.bus_errors;
   if (!report.state) return;
   if (*report.state == dr::CanBusState::kBusOff) ++c.bus_off;
   if (*report.state == dr::CanBusState::kErrorPassive) ++c.error_passive;
@@ -97,6 +99,7 @@ void print_counters(const fb::CanImuCounters& d, const InputCounters& in, bool j
       {"bus_off", in.bus_off},
       {"error_passive", in.error_passive},
       {"restarted", in.restarted},
+      {"bus_errors", in.bus_errors},
       {"frames", d.frames},
       {"unknown", d.unknown},
       {"samples", d.samples},

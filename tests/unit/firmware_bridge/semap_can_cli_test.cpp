@@ -157,7 +157,11 @@ TEST(SemapCanCli, ReportsBusEventsFromErrorFrames) {
   passive.id = 0x04;  // CAN_ERR_CRTL
   passive.len = 8;
   passive.data[1] = 0x20;  // CAN_ERR_CRTL_TX_PASSIVE
+  SemapCanFrame no_ack{};
+  no_ack.id = 0x20;  // CAN_ERR_ACK: a bus error, no state change
+  no_ack.len = 8;
   const std::string log = imu_log(false, 4) + line_of(passive, 20000, SEMAP_CANDUMP_ERROR) +
+                          line_of(no_ack, 25000, SEMAP_CANDUMP_ERROR) +
                           line_of(busoff, 30000, SEMAP_CANDUMP_ERROR) +
                           line_of(restarted, 40000, SEMAP_CANDUMP_ERROR);
   const std::string path = write_file("errors.log", log);
@@ -168,7 +172,8 @@ TEST(SemapCanCli, ReportsBusEventsFromErrorFrames) {
   EXPECT_EQ(events[0], "1700000000.020000 bus error-passive");
   EXPECT_EQ(events[1], "1700000000.030000 bus bus-off");
   EXPECT_EQ(events[2], "1700000000.040000 bus error-active (restarted)");
-  EXPECT_EQ(counter(r.out, "error_frames"), "3");
+  EXPECT_EQ(counter(r.out, "error_frames"), "4");
+  EXPECT_EQ(counter(r.out, "bus_errors"), "1");
   EXPECT_EQ(counter(r.out, "bus_off"), "1");
   EXPECT_EQ(counter(r.out, "samples"), "4");
   std::filesystem::remove(path);
