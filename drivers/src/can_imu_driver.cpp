@@ -60,6 +60,8 @@ void CanImuDriver::service_device(std::stop_token /*stop*/) {
 }
 
 void CanImuDriver::apply(CanBusChange change) {
+  // The state first: whoever sees a counter move then sees the state that moved it.
+  bus_state_.store(bus_.state(), std::memory_order_release);
   if (change.entered_bus_off) {
     counters().add_bus_off();
     report(config_.interface + ": controller is bus-off", false);
@@ -72,7 +74,6 @@ void CanImuDriver::apply(CanBusChange change) {
     counters().add_bus_restart();
     log().info("{}: controller back on the bus after bus-off", config_.interface);
   }
-  bus_state_.store(bus_.state(), std::memory_order_release);
 }
 
 void CanImuDriver::watch_controller() {
