@@ -24,6 +24,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "child_pipe.hpp"
 #include "semap/dds_idl/block_cdr.hpp"
 #include "semap/dds_idl/block_codec.hpp"
 #include "semap/dds_idl/converters.hpp"
@@ -35,6 +36,7 @@
 namespace sd = semap::dds_idl;
 using semap::common::Stamp;
 using Clock = std::chrono::steady_clock;
+using semap::bench::Pipe;
 
 namespace {
 
@@ -67,29 +69,6 @@ double thread_cpu_seconds() {
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
-
-struct Pipe {
-  std::FILE* f = nullptr;
-  explicit Pipe(const std::string& cmd) : f(popen(cmd.c_str(), "r")) {
-    if (!f) throw std::runtime_error("popen " + cmd);
-  }
-  ~Pipe() {
-    if (f) pclose(f);
-  }
-  bool line(std::string& out) {
-    char buf[1024];
-    if (!std::fgets(buf, sizeof buf, f)) return false;
-    out = buf;
-    return true;
-  }
-  std::string expect(const std::string& prefix) {
-    std::string l;
-    while (line(l)) {
-      if (l.rfind(prefix, 0) == 0) return l;
-    }
-    throw std::runtime_error("child ended before '" + prefix + "'");
-  }
-};
 
 // ---- reader side (child process) ----
 

@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "child_pipe.hpp"
 #include "costmap_output.hpp"
 #include "mapping_stage.hpp"
 #include "semap/dds_idl/converters.hpp"
@@ -36,6 +37,7 @@ namespace sd = semap::dds_idl;
 namespace sm = semap::mapping;
 using semap::common::Stamp;
 using Clock = std::chrono::steady_clock;
+using semap::bench::Pipe;
 
 namespace {
 
@@ -166,22 +168,6 @@ int run_reader(int domain, const std::string& ns) {
 }
 
 // ---- publisher side ----
-
-struct Pipe {
-  std::FILE* f = nullptr;
-  explicit Pipe(const std::string& cmd) : f(popen(("exec " + cmd).c_str(), "r")) {
-    if (!f) throw std::runtime_error("popen " + cmd);
-  }
-  ~Pipe() {
-    if (f) pclose(f);
-  }
-  bool line(std::string& out) {
-    char buf[1024];
-    if (!std::fgets(buf, sizeof buf, f)) return false;
-    out = buf;
-    return true;
-  }
-};
 
 // The reader's lines, collected on a thread of their own: ages per topic.
 class ReaderLog {

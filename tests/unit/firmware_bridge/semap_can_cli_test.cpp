@@ -15,27 +15,14 @@
 #include "semap/firmware_bridge/can_imu.h"
 #include "semap/firmware_bridge/candump_reader.hpp"
 #include "semap/firmware_bridge/j1939.h"
+#include "support/cli_run.hpp"
 
 namespace semap::firmware_bridge {
 namespace {
 
-struct CliResult {
-  int status = -1;
-  std::string out;
-};
+using test_support::CliResult;
 
-CliResult run(const std::string& args) {
-  const std::string command = std::string(SEMAP_CAN_EXE) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buffer[4096];
-  std::size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) r.out.append(buffer, n);
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+CliResult run(const std::string& args) { return test_support::run_cli(SEMAP_CAN_EXE, args); }
 
 std::vector<std::string> lines_with(const std::string& text, const std::string& tag) {
   std::vector<std::string> out;

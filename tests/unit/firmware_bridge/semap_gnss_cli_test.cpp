@@ -17,26 +17,16 @@
 #include <thread>
 #include <vector>
 
+#include "support/cli_run.hpp"
+
 namespace {
 
 const std::string kDir = std::string(SEMAP_SHARED_DATA_DIR) + "/gnss/";
 
-struct CliResult {
-  int status = -1;
-  std::string out;
-};
+using semap::test_support::CliResult;
 
 CliResult run(const std::string& args) {
-  const std::string command = std::string(SEMAP_GNSS_EXE) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buffer[4096];
-  std::size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) r.out.append(buffer, n);
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return semap::test_support::run_cli(SEMAP_GNSS_EXE, args);
 }
 
 std::vector<std::string> lines(const std::string& text) {

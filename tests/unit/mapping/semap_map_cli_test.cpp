@@ -10,29 +10,16 @@
 #include <vector>
 
 #include "semap/map_io/pcd_io.hpp"
+#include "support/cli_run.hpp"
 
 namespace semap::mapping {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int status = -1;
-  std::string out;
-};
+using test_support::CliResult;
 
-CliResult run(const std::string& args) {
-  const std::string command = std::string(SEMAP_MAP_EXE) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buffer[4096];
-  std::size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) r.out.append(buffer, n);
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+CliResult run(const std::string& args) { return test_support::run_cli(SEMAP_MAP_EXE, args); }
 
 std::string toy(int i) {
   return std::string(SEMAP_SHARED_DATA_DIR) +
