@@ -32,11 +32,14 @@ std::uint64_t ConfusionMatrix::count(int truth, int predicted) const {
   return counts_[static_cast<std::size_t>(truth) * (k_ + 1) + column];
 }
 
+std::uint64_t ConfusionMatrix::truth_count(int c) const {
+  const auto row = counts_.begin() + static_cast<std::ptrdiff_t>(c) * (k_ + 1);
+  return std::accumulate(row, row + k_ + 1, std::uint64_t{0});
+}
+
 double ConfusionMatrix::iou(int c) const {
-  std::uint64_t tp = count(c, c), fn = 0, fp = 0;
-  for (int j = 0; j <= k_; ++j) {
-    if (j != c) fn += counts_[static_cast<std::size_t>(c) * (k_ + 1) + j];
-  }
+  const std::uint64_t tp = count(c, c), fn = truth_count(c) - tp;
+  std::uint64_t fp = 0;
   for (int t = 0; t < k_; ++t) {
     if (t != c) fp += count(t, c);
   }

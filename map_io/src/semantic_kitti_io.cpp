@@ -32,13 +32,13 @@ bool parse_3x4(std::istringstream& in, Eigen::Isometry3d& out) {
   return true;
 }
 
-std::string frame_name(std::size_t index, const char* extension) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "%06zu%s", index, extension);
-  return name;
-}
-
 }  // namespace
+
+std::string kitti_frame_name(std::size_t index, std::string_view extension) {
+  char digits[24];
+  std::snprintf(digits, sizeof(digits), "%06zu", index);
+  return std::string(digits).append(extension);
+}
 
 std::uint16_t kitti_learning_map(std::uint32_t raw_label) {
   static const std::unordered_map<std::uint32_t, std::uint16_t> kMap{
@@ -136,8 +136,8 @@ common::LabeledCloud KittiSequence::scan(std::size_t index) const {
     throw KittiError(folder_.string() + ": scan " + std::to_string(index) + " beyond " +
                      std::to_string(poses_.size()) + " poses");
   }
-  const auto scan_path = folder_ / "velodyne" / frame_name(index, ".bin");
-  const auto label_path = folder_ / "labels" / frame_name(index, ".label");
+  const auto scan_path = folder_ / "velodyne" / kitti_frame_name(index, ".bin");
+  const auto label_path = folder_ / "labels" / kitti_frame_name(index, ".label");
   const auto points = read_kitti_scan(scan_path);
   const auto labels = read_kitti_labels(label_path);
   if (labels.size() != points.size()) {

@@ -22,6 +22,8 @@ class ConfusionMatrix {
   int num_classes() const { return k_; }
   std::uint64_t count(int truth, int predicted) const;  // predicted may be -1
   std::uint64_t total() const { return total_; }
+  // Points whose true class is c, whatever was predicted.
+  std::uint64_t truth_count(int c) const;
 
   // TP / (TP + FP + FN); NaN when the class appears neither in truth nor in predictions.
   double iou(int c) const;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "semap/common/messages.hpp"
@@ -28,6 +29,9 @@ inline constexpr int kKittiClasses = 20;
 std::uint16_t kitti_learning_map(std::uint32_t raw_label);
 // Class names of the 20 learning classes, index = class.
 const std::array<const char*, kKittiClasses>& kitti_class_names();
+
+// The dataset's file name of scan `index`: six digits and `extension` (".bin", ".label").
+std::string kitti_frame_name(std::size_t index, std::string_view extension);
 
 // velodyne/NNNNNN.bin: float32 x, y, z, remission per point.
 std::vector<Eigen::Vector4f> read_kitti_scan(const std::filesystem::path& path);
