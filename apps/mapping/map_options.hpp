@@ -13,12 +13,12 @@ namespace semap::apps {
 struct MapOptions {
   mapping::MapParams flags;
   std::string method = "bki";
+  bool method_flag = false;  // --method is this struct's (tools choosing methods otherwise: no)
   std::string config_path;
 };
 
-inline void add_map_options(CLI::App& app, MapOptions& o) {
-  app.add_option("--method", o.method, "bki, csm (or logodds in semap-map)")
-      ->check(CLI::IsMember({"bki", "csm", "logodds"}));
+// Every map parameter flag except --method.
+inline void add_map_parameter_options(CLI::App& app, MapOptions& o) {
   app.add_option("--resolution", o.flags.resolution, "cell size, m");
   app.add_option("--block-depth", o.flags.block_depth, "block holds (2^(depth-1))^3 cells");
   app.add_option("--num-classes", o.flags.num_classes, "K, class 0 = free");
@@ -33,8 +33,17 @@ inline void add_map_options(CLI::App& app, MapOptions& o) {
   app.add_option("--config", o.config_path, "YAML with map parameters (flags override)");
 }
 
-inline mapping::MapParams resolve_map_params(const CLI::App& app, const MapOptions& o) {
-  mapping::MapParams p;
+inline void add_map_options(CLI::App& app, MapOptions& o) {
+  app.add_option("--method", o.method, "bki, csm (or logodds in semap-map)")
+      ->check(CLI::IsMember({"bki", "csm", "logodds"}));
+  o.method_flag = true;
+  add_map_parameter_options(app, o);
+}
+
+// `defaults`, then the YAML file, then the flags given.
+inline mapping::MapParams resolve_map_params(const CLI::App& app, const MapOptions& o,
+                                             const mapping::MapParams& defaults = {}) {
+  mapping::MapParams p = defaults;
   if (!o.config_path.empty()) {
     const auto root = common::ConfigSection::load_file(o.config_path);
     const auto section = root.has("map") ? root.section("map") : root;
@@ -44,7 +53,7 @@ inline mapping::MapParams resolve_map_params(const CLI::App& app, const MapOptio
   }
   const auto& f = o.flags;
   auto given = [&](const char* flag) { return app.count(flag) > 0; };
-  if (given("--method")) p.method = mapping::map_method_from_string(o.method);
+  if (o.method_flag && given("--method")) p.method = mapping::map_method_from_string(o.method);
   if (given("--resolution")) p.resolution = f.resolution;
   if (given("--block-depth")) p.block_depth = f.block_depth;
   if (given("--num-classes")) p.num_classes = f.num_classes;

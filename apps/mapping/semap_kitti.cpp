@@ -1,0 +1,14 @@
+// semap-kitti: the SemanticKITTI evaluations of the semantic map, one subcommand each.
+#include <CLI/CLI.hpp>
+
+#include "kitti_semantic_command.hpp"
+#include "semap/common/logging.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"SemanticKITTI evaluations of the S-BKI / S-CSM semantic map"};
+  app.require_subcommand(1);
+  semap::apps::add_kitti_semantic_command(app);
+  semap::common::setup_logging("warn");
+  CLI11_PARSE(app, argc, argv);
+  return 0;
+}
