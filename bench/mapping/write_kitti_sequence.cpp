@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -25,13 +24,6 @@ namespace fs = std::filesystem;
 constexpr std::array<std::uint32_t, 20> kRawIds{0,  40, 48, 0,  0,  10, 18, 20, 11, 15,
                                                 80, 81, 50, 51, 70, 71, 72, 44, 49, 30};
 
-void write_matrix(std::ofstream& out, const Eigen::Isometry3d& T) {
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 4; ++c) out << (r + c ? " " : "") << T(r, c);
-  }
-  out << '\n';
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -46,33 +38,26 @@ int main(int argc, char** argv) {
   // Tr takes velodyne (x forward, z up) to camera (z forward, y down) coordinates.
   Eigen::Isometry3d velo_to_cam = Eigen::Isometry3d::Identity();
   velo_to_cam.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
-  std::ofstream calib(out / "calib.txt");
-  calib << "P0: 718.856 0 607.1928 0 0 718.856 185.2157 0 0 0 1 0\nTr: ";
-  write_matrix(calib, velo_to_cam);
-  std::ofstream poses(out / "poses.txt");
-  poses.precision(9);
+  semap::map_io::write_kitti_calibration(out / "calib.txt", velo_to_cam);
+  std::vector<Eigen::Isometry3d> poses;
   const semap::bench::SyntheticLidar lidar;
   for (int s = 0; s < scans; ++s) {
     const semap::common::LabeledCloud cloud = lidar.scan(s);
-    Eigen::Isometry3d world_velo = Eigen::Isometry3d::Identity();
-    world_velo.translation() = cloud.origin.cast<double>();
-    write_matrix(poses, world_velo * velo_to_cam.inverse());
-    std::vector<float> xyzr;
+    poses.push_back(Eigen::Translation3d(cloud.origin.cast<double>()) * velo_to_cam.inverse());
+    std::vector<Eigen::Vector4f> xyzr;
     std::vector<std::uint32_t> raw;
-    xyzr.reserve(cloud.size() * 4);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       const Eigen::Vector3f p = cloud.points[i] - cloud.origin;
-      xyzr.insert(xyzr.end(), {p.x(), p.y(), p.z(), 0.5f});
+      xyzr.emplace_back(p.x(), p.y(), p.z(), 0.5f);
       raw.push_back(kRawIds.at(cloud.labels[i]));
     }
-    const std::string name = semap::map_io::kitti_frame_name(static_cast<std::size_t>(s), "");
-    std::ofstream(out / "velodyne" / (name + ".bin"), std::ios::binary)
-        .write(reinterpret_cast<const char*>(xyzr.data()),
-               static_cast<std::streamsize>(xyzr.size() * sizeof(float)));
-    std::ofstream(out / "labels" / (name + ".label"), std::ios::binary)
-        .write(reinterpret_cast<const char*>(raw.data()),
-               static_cast<std::streamsize>(raw.size() * sizeof(std::uint32_t)));
+    const auto index = static_cast<std::size_t>(s);
+    semap::map_io::write_kitti_scan(
+        out / "velodyne" / semap::map_io::kitti_frame_name(index, ".bin"), xyzr);
+    semap::map_io::write_kitti_labels(
+        out / "labels" / semap::map_io::kitti_frame_name(index, ".label"), raw);
   }
+  semap::map_io::write_kitti_poses(out / "poses.txt", poses);
   std::printf("wrote %d scans to %s\n", scans, out.c_str());
   return 0;
 }

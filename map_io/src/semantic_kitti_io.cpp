@@ -32,6 +32,20 @@ bool parse_3x4(std::istringstream& in, Eigen::Isometry3d& out) {
   return true;
 }
 
+void write_bytes(const std::filesystem::path& path, const void* data, std::size_t bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
+  if (!out) throw KittiError(path.string() + ": cannot write");
+}
+
+// A row-major 3x4 matrix on one line, as poses.txt and calib.txt hold it.
+void write_3x4(std::ofstream& out, const Eigen::Isometry3d& T) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) out << (r + c > 0 ? " " : "") << T(r, c);
+  }
+  out << '\n';
+}
+
 }  // namespace
 
 std::string kitti_frame_name(std::size_t index, std::string_view extension) {
@@ -119,6 +133,34 @@ Eigen::Isometry3d read_kitti_velodyne_to_camera(const std::filesystem::path& pat
     return tr;
   }
   throw KittiError(path.string() + ": no Tr: line");
+}
+
+void write_kitti_scan(const std::filesystem::path& path, std::span<const Eigen::Vector4f> points) {
+  std::vector<float> xyzr;
+  xyzr.reserve(points.size() * 4);
+  for (const Eigen::Vector4f& p : points) xyzr.insert(xyzr.end(), p.data(), p.data() + 4);
+  write_bytes(path, xyzr.data(), xyzr.size() * sizeof(float));
+}
+
+void write_kitti_labels(const std::filesystem::path& path, std::span<const std::uint32_t> labels) {
+  write_bytes(path, labels.data(), labels.size_bytes());
+}
+
+void write_kitti_poses(const std::filesystem::path& path,
+                       std::span<const Eigen::Isometry3d> poses) {
+  std::ofstream out(path);
+  out.precision(17);
+  for (const Eigen::Isometry3d& pose : poses) write_3x4(out, pose);
+  if (!out) throw KittiError(path.string() + ": cannot write");
+}
+
+void write_kitti_calibration(const std::filesystem::path& path,
+                             const Eigen::Isometry3d& velo_to_cam) {
+  std::ofstream out(path);
+  out.precision(17);
+  out << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr: ";
+  write_3x4(out, velo_to_cam);
+  if (!out) throw KittiError(path.string() + ": cannot write");
 }
 
 KittiSequence::KittiSequence(std::filesystem::path folder)

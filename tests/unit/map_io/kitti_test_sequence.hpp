@@ -37,31 +37,26 @@ class KittiTestSequence {
   void write_poses(const std::vector<Eigen::Vector3d>& lidar_positions) {
     Eigen::Isometry3d velo_to_cam = Eigen::Isometry3d::Identity();
     velo_to_cam.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
-    std::ofstream calib(dir_ / "calib.txt");
-    calib << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr:";
-    write_3x4(calib, velo_to_cam);
-    std::ofstream poses(dir_ / "poses.txt");
+    write_kitti_calibration(dir_ / "calib.txt", velo_to_cam);
+    std::vector<Eigen::Isometry3d> poses;
     for (const Eigen::Vector3d& position : lidar_positions) {
-      Eigen::Isometry3d world_velo = Eigen::Isometry3d::Identity();
-      world_velo.translation() = position;
-      write_3x4(poses, world_velo * velo_to_cam.inverse());
+      poses.push_back(Eigen::Translation3d(position) * velo_to_cam.inverse());
     }
+    write_kitti_poses(dir_ / "poses.txt", poses);
   }
 
-  // Scan `index` (points in the sensor frame) with raw label ids in `folder` (labels/ or
-  // predictions/).
+  // Scan `index` (points in the sensor frame) and its ground truth (raw label ids).
   void write_scan(std::size_t index, const std::vector<Eigen::Vector3f>& points,
                   const std::vector<std::uint32_t>& raw_labels) {
-    std::vector<float> xyzr;
-    for (const Eigen::Vector3f& p : points) xyzr.insert(xyzr.end(), {p.x(), p.y(), p.z(), 0.0f});
-    write_bytes("velodyne/" + kitti_frame_name(index, ".bin"), xyzr.data(),
-                xyzr.size() * sizeof(float));
+    std::vector<Eigen::Vector4f> xyzr;
+    for (const Eigen::Vector3f& p : points) xyzr.emplace_back(p.x(), p.y(), p.z(), 0.0f);
+    write_kitti_scan(dir_ / "velodyne" / kitti_frame_name(index, ".bin"), xyzr);
     write_labels("labels", index, raw_labels);
   }
+  // Raw label ids of scan `index` in `folder` (labels or predictions).
   void write_labels(const std::string& folder, std::size_t index,
                     const std::vector<std::uint32_t>& raw_labels) {
-    write_bytes(folder + "/" + kitti_frame_name(index, ".label"), raw_labels.data(),
-                raw_labels.size() * sizeof(std::uint32_t));
+    write_kitti_labels(dir_ / folder / kitti_frame_name(index, ".label"), raw_labels);
   }
   void write_bytes(const std::string& relative, const void* data, std::size_t bytes) {
     std::ofstream(dir_ / relative, std::ios::binary)
@@ -69,13 +64,6 @@ class KittiTestSequence {
   }
 
  private:
-  static void write_3x4(std::ofstream& out, const Eigen::Isometry3d& T) {
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) out << ' ' << T(r, c);
-    }
-    out << '\n';
-  }
-
   std::filesystem::path dir_;
 };
 

@@ -1,35 +1,20 @@
 // Runs build/bin/semap-kitti as a user would: its table, figures, errors and exit codes.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "kitti_test_sequence.hpp"
+#include "support/cli_run.hpp"
 
 namespace semap::map_io {
 namespace {
 
+using test_support::CliResult;
 using testing::KittiTestSequence;
 
-struct CliResult {
-  int status = -1;
-  std::string out;
-};
-
-CliResult run(const std::string& args) {
-  const std::string command = std::string(SEMAP_KITTI_EXE) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buffer[4096];
-  std::size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) r.out.append(buffer, n);
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+CliResult run(const std::string& args) { return test_support::run_cli(SEMAP_KITTI_EXE, args); }
 
 bool has(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;

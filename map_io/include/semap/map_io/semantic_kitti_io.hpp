@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -41,6 +42,15 @@ std::vector<std::uint32_t> read_kitti_labels(const std::filesystem::path& path);
 std::vector<Eigen::Isometry3d> read_kitti_poses(const std::filesystem::path& path);
 // calib.txt: "Tr:" 12 numbers, velodyne to left camera.
 Eigen::Isometry3d read_kitti_velodyne_to_camera(const std::filesystem::path& path);
+
+// Writers of the same formats (synthetic sequences for tests and benchmarks); each throws
+// KittiError naming the file when it cannot be written.
+void write_kitti_scan(const std::filesystem::path& path, std::span<const Eigen::Vector4f> points);
+void write_kitti_labels(const std::filesystem::path& path, std::span<const std::uint32_t> labels);
+void write_kitti_poses(const std::filesystem::path& path, std::span<const Eigen::Isometry3d> poses);
+// calib.txt with an identity P0 and `velo_to_cam` as Tr.
+void write_kitti_calibration(const std::filesystem::path& path,
+                             const Eigen::Isometry3d& velo_to_cam);
 
 // One sequence folder (velodyne/, labels/, poses.txt, calib.txt).
 class KittiSequence {
