@@ -35,7 +35,7 @@ class SemapKittiCli : public ::testing::Test {
 };
 
 TEST_F(SemapKittiCli, PrintsTheTableTimingAndMemory) {
-  const CliResult r = run(sequence() + " --threads 2 --flip 0");
+  const CliResult r = run(sequence() + " --threads 2 --flip 0 --progress-seconds 0.000001");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(has(r.out, "threads 2")) << r.out;
   EXPECT_TRUE(has(r.out, "ell 0.3")) << r.out;
@@ -46,11 +46,14 @@ TEST_F(SemapKittiCli, PrintsTheTableTimingAndMemory) {
   EXPECT_TRUE(has(r.out, "insert_ms S-BKI median")) << r.out;
   EXPECT_TRUE(has(r.out, "peak_memory_mib")) << r.out;
   EXPECT_TRUE(has(r.out, "scans 2 points 6")) << r.out;
+  EXPECT_TRUE(has(r.out, "semap-kitti semantic: 2/2 scans")) << r.out;
+  EXPECT_TRUE(has(r.out, "ETA 0 s")) << r.out;
   const CliResult bki = run(sequence() + " --method bki --first 1 --ell 0.2");
   ASSERT_EQ(bki.status, 0) << bki.out;
   EXPECT_FALSE(has(bki.out, "S-CSM")) << bki.out;
   EXPECT_TRUE(has(bki.out, "ell 0.2")) << bki.out;
   EXPECT_TRUE(has(bki.out, "scans 1 points 3")) << bki.out;
+  EXPECT_FALSE(has(bki.out, "ETA")) << bki.out;  // no progress line within 5 s
 }
 
 TEST_F(SemapKittiCli, BadInputNamesTheFileAndSetsTheExitStatus) {
