@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
-#include <regex>
 #include <string>
 
 #include "hil_env.hpp"
@@ -45,10 +44,11 @@ class CameraToolHil : public ::testing::Test {
   fs::path dir_;
 };
 
+// The number after "key": in the tool's JSON line, or -1 when the key is missing.
 double json_number(const std::string& json, const std::string& key) {
-  const std::regex re("\"" + key + "\":([-0-9.eE]+)");
-  std::smatch m;
-  return std::regex_search(json, m, re) ? std::stod(m[1]) : -1.0;
+  const std::string field = "\"" + key + "\":";
+  const auto at = json.find(field);
+  return at == std::string::npos ? -1.0 : std::strtod(json.c_str() + at + field.size(), nullptr);
 }
 
 TEST_F(CameraToolHil, ListsWhatTheDeviceEnumerates) {
