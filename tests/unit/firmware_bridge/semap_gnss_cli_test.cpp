@@ -154,9 +154,13 @@ TEST(SemapGnssCli, ReadsASerialDeviceUntilCountAndRecordsIt) {
   ASSERT_EQ(r.status, 0) << r.out;
   const std::vector<std::string> out = lines(r.out);
   ASSERT_EQ(out.size(), 3u + 1u) << r.out;
+  // Joining mid-stream, a GGA before the first RMC has no date yet: its time is null. Once an
+  // RMC was read (at the latest by the third fix, one epoch later) every time is dated.
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(field(out[i], "mode"), "dgps") << out[i];
-    EXPECT_EQ(field(out[i], "time").rfind("2020-07-11T22:", 0), 0u) << out[i];
+    const std::string time = field(out[i], "time");
+    if (i < 2 && time == "null") continue;
+    EXPECT_EQ(time.rfind("2020-07-11T22:", 0), 0u) << out[i];
   }
   EXPECT_EQ(field(out.back(), "bytes"), std::to_string(std::filesystem::file_size(recording)));
   std::filesystem::remove(recording);
