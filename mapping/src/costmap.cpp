@@ -144,15 +144,15 @@ class ColumnReader {
       for (int z = 0; z < side; ++z) {
         const int c = block->cell_of(x, y, z);
         if (!block->observed(c)) continue;
-        const common::CellPosterior cell(block->cell_evidence(c), map_.prior, true);
-        const common::CellState state = cell.state(map_.unknown_variance);
-        if (state == common::CellState::kUnknown) continue;
-        if (state == common::CellState::kFree) {
+        const auto cell = common::CellPosterior(block->cell_evidence(c), map_.prior, true)
+                              .summary(map_.unknown_variance);
+        if (cell.state == common::CellState::kUnknown) continue;
+        if (cell.state == common::CellState::kFree) {
           evidence.free = true;
           continue;
         }
-        const int label = cell.argmax();
-        const bool too_uncertain = p_.max_variance > 0.0 && cell.variance(label) > p_.max_variance;
+        const int label = cell.argmax;
+        const bool too_uncertain = p_.max_variance > 0.0 && cell.variance > p_.max_variance;
         occupied_.push_back(
             {key.z * side + z, label,
              !too_uncertain && p_.class_cost[static_cast<std::size_t>(label)] >= 0});
