@@ -20,7 +20,11 @@ EstimationStage::EstimationStage(const EstimationStageConfig& config,
       gnss_ring_(gnss),
       poses_(poses),
       pose_sink_(std::move(pose_sink)),
-      estimator_(config.estimator) {}
+      estimator_(config.estimator) {
+  if (!config.trajectory.empty()) {
+    trajectory_ = std::make_unique<TrajectoryLog>(config.trajectory, config.trajectory_offset_ns);
+  }
+}
 
 EstimationStage::~EstimationStage() { stop(); }
 
@@ -35,7 +39,6 @@ EstimationStageStats EstimationStage::stats() const { return stage_.stats(); }
 void EstimationStage::run(std::stop_token stop) {
   while (!stop.stop_requested()) {
     const bool busy = drain_sensors();
-    check_heading();
     publish_pose();
     share_stats();
     if (!busy) std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -57,9 +60,14 @@ bool EstimationStage::drain_sensors() {
     last_imu_ = imu_batch[i];
     estimator_.add_imu(imu_batch[i]);
     ++stage_.figures().imu_samples;
-    if (stage_.figures().heading_settled) {
-      if (auto pose = estimator_.pose_at(estimator_.filter_time())) new_poses_.push_back(*pose);
-    }
+    // Per sample, not per batch: when mapping starts then depends on the samples only, not on
+    // how the thread happened to batch them (a replay maps what its recording mapped).
+    check_heading();
+    if (!stage_.figures().heading_settled && !trajectory_) continue;
+    const auto pose = estimator_.pose_at(estimator_.filter_time());
+    if (!pose) continue;
+    if (trajectory_) trajectory_->write(*pose);
+    if (stage_.figures().heading_settled) new_poses_.push_back(*pose);
   }
   if (n_imu > 0) {
     const common::Stamp done = common::Stamp::now();

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -13,6 +15,7 @@
 #include "semap/estimation/estimator.hpp"
 #include "shared_pose_history.hpp"
 #include "stage_thread.hpp"
+#include "trajectory_log.hpp"
 
 namespace semap::onboard {
 
@@ -43,6 +46,8 @@ struct EstimationStageConfig {
   estimation::EstimatorConfig estimator;
   double map_start_heading_sigma_deg = 3.0;
   double odometry_hz = 50.0;
+  std::filesystem::path trajectory;  // --trajectory: every pose as CSV (TrajectoryLog)
+  std::int64_t trajectory_offset_ns = 0;
 };
 
 // Owns the Estimator on its own thread: drains the IMU and GNSS rings in stamp order and
@@ -79,6 +84,7 @@ class EstimationStage {
   PoseSink pose_sink_;
   estimation::Estimator estimator_;
   std::vector<estimation::StampedPose> new_poses_;
+  std::unique_ptr<TrajectoryLog> trajectory_;
   common::Stamp next_heading_check_;
   common::ImuSample last_imu_;
   common::Stamp next_pose_publish_;

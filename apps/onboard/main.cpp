@@ -2,7 +2,8 @@
 // perception stage (segmentation, labelled points posed at their stamps) -> mapping stage
 // (S-BKI) -> DDS. With rig.kind: sim it runs on the built-in
 // simulated sensor rig and reports its own accuracy against the simulated truth (--report DIR:
-// images, the map and summary.json, see SimReport).
+// images, the map and summary.json, see SimReport). --record DIR saves the raw sensor streams
+// (StreamRecorder); rig.kind: replay (or --replay DIR) plays them back (ReplayRig).
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
@@ -22,6 +23,7 @@
 #include "mapping_stage.hpp"
 #include "onboard_config.hpp"
 #include "perception_stage.hpp"
+#include "replay_rig.hpp"
 #include "segmenter_factory.hpp"
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
@@ -32,6 +34,7 @@
 #include "shared_pose_history.hpp"
 #include "sim_report.hpp"
 #include "sim_rig.hpp"
+#include "stream_recorder.hpp"
 
 namespace {
 
@@ -152,8 +155,17 @@ class Progress {
   std::uint64_t imu_ = 0, gnss_ = 0, frames_ = 0, clouds_ = 0, scans_ = 0;
 };
 
-int run(const semap::onboard::OnboardConfig& config, const std::string& report_dir) {
+// What the command line adds to the configuration.
+struct RunOptions {
+  std::filesystem::path config_path;
+  std::string report_dir;
+  std::string record_dir;
+  std::string trajectory;
+};
+
+int run(const semap::onboard::OnboardConfig& config, const RunOptions& options) {
   using namespace semap;
+  const std::string& report_dir = options.report_dir;
   auto log = common::logger("onboard");
   SpscRing<common::ImuSample> imu_ring(config.imu.ring, OverflowPolicy::kDropOldest);
   SpscRing<common::GnssFix> gnss_ring(config.gnss.ring, OverflowPolicy::kDropOldest);
@@ -163,8 +175,17 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   onboard::SharedPoseHistory poses(config.estimator.history);
 
   std::unique_ptr<onboard::SimRig> rig;
-  if (config.rig.simulated) {
+  std::unique_ptr<onboard::ReplayRig> replay;
+  if (config.rig.kind == onboard::RigKind::kSim) {
     rig = std::make_unique<onboard::SimRig>(config, imu_ring, colour_ring, depth_ring);
+  } else if (config.rig.kind == onboard::RigKind::kReplay) {
+    replay =
+        std::make_unique<onboard::ReplayRig>(config, imu_ring, gnss_ring, colour_ring, depth_ring);
+  }
+  std::unique_ptr<onboard::StreamRecorder> recorder;
+  if (!options.record_dir.empty()) {
+    recorder = std::make_unique<onboard::StreamRecorder>(options.record_dir, options.config_path,
+                                                         config.imu.interface);
   }
   std::unique_ptr<onboard::SimReport> report;
   if (!report_dir.empty()) report = std::make_unique<onboard::SimReport>(*rig, report_dir);
@@ -172,19 +193,35 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   std::unique_ptr<drivers::GnssDriver> gnss_driver;
   auto gnss_config = config.gnss.driver;
   if (rig && !rig->gnss_device().empty()) gnss_config.serial.device = rig->gnss_device();
-  if (gnss_config.serial.device != "pty") {
+  // A replay feeds its pty (recorded pace) or the GNSS ring itself: never the robot's port.
+  if (replay) gnss_config.serial.device = replay->gnss_device();
+  if (!gnss_config.serial.device.empty() && gnss_config.serial.device != "pty") {
     gnss_driver = std::make_unique<drivers::GnssDriver>(gnss_config, gnss_ring);
+    if (recorder) {
+      gnss_driver->set_byte_tap([&](common::Stamp stamp, std::span<const std::uint8_t> bytes) {
+        recorder->gnss_bytes(stamp, bytes);
+      });
+    }
   }
   std::unique_ptr<drivers::CanImuDriver> imu_driver;
-  if (!config.imu.interface.empty()) {
+  if (!config.imu.interface.empty() && !replay) {
     imu_driver = std::make_unique<drivers::CanImuDriver>(config.imu.driver, imu_ring);
+    if (recorder) {
+      imu_driver->set_frame_tap([&](const drivers::CanRxFrame& rx, drivers::CanRead read) {
+        recorder->can_frame(rx.stamp, rx.frame, read == drivers::CanRead::kError);
+      });
+    }
+  } else if (rig && recorder) {
+    rig->set_can_tap([&](common::Stamp stamp, const SemapCanFrame& frame) {
+      recorder->can_frame(stamp, frame, false);
+    });
   }
 
   // On hardware the camera is optional (an empty camera.device): without it the robot still
   // estimates and publishes its pose, and its map stays empty. A segmenter or calibration that
   // does not load leaves the robot in the same state, with the error logged: localisation must
   // not depend on the camera half.
-  const bool camera = rig || !config.camera.driver.device.empty();
+  const bool camera = rig || (replay ? replay->has_camera() : !config.camera.driver.device.empty());
   std::unique_ptr<onboard::PerceptionStage> perception_stage;
   if (camera) {
     try {
@@ -202,7 +239,12 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   std::unique_ptr<drivers::CameraDriver> depth_driver;
   // The simulated rig fills the rings itself, unless it shows its colour frames on a V4L2
   // output (rig.camera_output): the camera driver captures them back.
-  if (perception_stage && (!rig || !config.rig.camera_output.empty())) {
+  if (perception_stage && recorder) {
+    perception_stage->set_frame_tap([&](const common::ImageFrame& frame, bool depth) {
+      depth ? recorder->depth_frame(frame) : recorder->colour_frame(frame);
+    });
+  }
+  if (perception_stage && !replay && (!rig || !config.rig.camera_output.empty())) {
     camera_driver = std::make_unique<drivers::CameraDriver>(config.camera.driver, colour_ring);
     if (!rig && config.depth.source == onboard::DepthSource::kAligned) {
       depth_driver = std::make_unique<drivers::CameraDriver>(config.depth.driver, depth_ring);
@@ -232,7 +274,8 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
                                                 config.costmap, &mapping_stage.costmaps());
   // A resumed map lives in the frame it was built in: the estimator anchors there too.
   onboard::EstimationStageConfig estimation_config{
-      config.estimator, config.map.start_heading_sigma_deg, config.dds.odometry_hz};
+      config.estimator, config.map.start_heading_sigma_deg, config.dds.odometry_hz,
+      options.trajectory, replay ? replay->offset_ns() : 0};
   if (const auto frame = mapping_stage.map_frame()) {
     const estimation::Geodetic anchor{(*frame)[0], (*frame)[1], (*frame)[2]};
     const auto& given = config.estimator.anchor;
@@ -268,8 +311,21 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
   if (perception_stage) perception_stage->start();
   mapping_stage.start();
   if (dds) dds->start();
+  if (replay) {
+    replay->set_settled([&](const onboard::ReplayCounters& handed) {
+      const auto e = estimation_stage.stats();
+      if (e.imu_samples < handed.imu_samples || e.gnss_fixes < handed.gnss_fixes) return false;
+      if (!perception_stage) return true;
+      const auto p = perception_stage->stats();
+      const auto done = p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose;
+      return p.frames == handed.colour_frames && done == p.frames &&
+             mapping_stage.stats().scans + drops(cloud_ring) == p.clouds;
+    });
+  }
   if (rig) rig->start();
-  log->info("running{}", rig ? " on the simulated rig (GNSS via " + rig->gnss_device() + ")" : "");
+  if (replay) replay->start();
+  log->info("running{}{}", rig ? " on the simulated rig (GNSS via " + rig->gnss_device() + ")" : "",
+            replay ? " on a replay of " + config.rig.replay.string() : "");
 
   LiveAccuracy accuracy;
   const auto started = common::Stamp::now();
@@ -313,21 +369,23 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
                                                      : onboard::PerceptionStageStats{},
                                     mapping_stage.stats(), rings));
     }
-    if (rig && rig->finished()) {
+    if ((rig && rig->finished()) || (replay && replay->finished())) {
       std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the stages drain
       break;
     }
-    if (!rig && config.rig.duration_s > 0 &&
+    if (!rig && !replay && config.rig.duration_s > 0 &&
         common::seconds_between(now, started) > config.rig.duration_s) {
       break;
     }
   }
 
   if (rig) rig->stop();
+  if (replay) replay->stop();
   if (imu_driver) imu_driver->stop();
   if (gnss_driver) gnss_driver->stop();
   if (camera_driver) camera_driver->stop();
   if (depth_driver) depth_driver->stop();
+  if (recorder) recorder->flush();
   estimation_stage.stop();
   if (perception_stage) perception_stage->stop();
   mapping_stage.stop();
@@ -420,6 +478,23 @@ int run(const semap::onboard::OnboardConfig& config, const std::string& report_d
           c->grids_written, c->rebuilds, c->updates_written, 1e3 * c->last_seconds);
     }
   }
+  if (recorder) {
+    const auto r = recorder->counters();
+    std::printf(
+        "recording        : %s: %lu CAN frames, %lu GNSS reads (%lu bytes), %lu colour and %lu "
+        "depth frames, %.1f MB, %lu write failures\n",
+        recorder->dir().c_str(), r.can_frames, r.gnss_reads, r.gnss_bytes, r.colour_frames,
+        r.depth_frames, static_cast<double>(r.bytes) / 1e6, r.write_failures);
+  }
+  if (replay) {
+    const auto r = replay->counters();
+    const std::string damage = replay->error();
+    std::printf(
+        "replay           : %lu CAN frames (%lu error frames), %lu IMU samples, %lu GNSS reads, "
+        "%lu colour and %lu depth frames%s%s\n",
+        r.can_frames, r.can_error_frames, r.imu_samples, r.gnss_reads, r.colour_frames,
+        r.depth_frames, damage.empty() ? "" : "; damaged: ", damage.c_str());
+  }
   std::printf("ring drops       : imu %lu, gnss %lu, colour %lu, depth %lu, clouds %lu\n",
               drops(imu_ring), drops(gnss_ring), drops(colour_ring), drops(depth_ring),
               drops(cloud_ring));
@@ -458,9 +533,22 @@ int main(int argc, char** argv) {
   CLI::App app{"semap-onboard: drivers, InEKF, S-BKI semantic map and DDS on one robot"};
   std::string config_path;
   std::optional<double> duration;
-  app.add_option("--config", config_path, "YAML configuration (see config/sim.yaml)")
-      ->required()
+  RunOptions options;
+  std::string replay_dir, pace, save_path;
+  app.add_option("--config", config_path,
+                 "YAML configuration (see config/sim.yaml); with --replay, the recording's")
       ->check(CLI::ExistingFile);
+  app.add_option("--record", options.record_dir,
+                 "save the raw sensor streams into this new directory (docs/record-replay.md)");
+  app.add_option("--replay", replay_dir,
+                 "play back a recording made with --record (rig.kind: replay, rig.replay: DIR)")
+      ->check(CLI::ExistingDirectory)
+      ->excludes("--record");
+  app.add_option("--pace", pace, "replay pace, overrides rig.pace: recorded | fast")
+      ->check(CLI::IsMember({"recorded", "fast"}));
+  app.add_option("--trajectory", options.trajectory,
+                 "write the filter's pose after every IMU sample to this CSV file");
+  app.add_option("--save", save_path, "save the map to this .smap file at exit (map.save_path)");
   std::optional<int> domain;
   std::string report_dir;
   app.add_option("--duration", duration, "seconds to run; overrides rig.duration_s (0: Ctrl-C)");
@@ -473,6 +561,13 @@ int main(int argc, char** argv) {
                  "simulated rig only: write camera.png, trajectory.png, map.smap and "
                  "summary.json into this directory");
   CLI11_PARSE(app, argc, argv);
+  if (config_path.empty() && replay_dir.empty()) {
+    std::cerr << "semap-onboard: --config is required (or --replay DIR)\n";
+    return 2;
+  }
+  if (config_path.empty()) config_path = replay_dir + "/config.yaml";
+  options.config_path = config_path;
+  options.report_dir = report_dir;
 
   semap::onboard::OnboardConfig config;
   try {
@@ -481,7 +576,20 @@ int main(int argc, char** argv) {
     std::cerr << "semap-onboard: " << e.what() << "\n";
     return 2;
   }
-  if (!report_dir.empty() && !config.rig.simulated) {
+  if (!replay_dir.empty()) {
+    config.rig.kind = semap::onboard::RigKind::kReplay;
+    config.rig.replay = replay_dir;
+  }
+  if (!pace.empty()) {
+    config.rig.pace =
+        pace == "fast" ? semap::onboard::ReplayPace::kFast : semap::onboard::ReplayPace::kRecorded;
+  }
+  if (!save_path.empty()) config.map.save_path = save_path;
+  if (!options.record_dir.empty() && config.rig.kind == semap::onboard::RigKind::kReplay) {
+    std::cerr << "semap-onboard: --record cannot record a replay\n";
+    return 2;
+  }
+  if (!report_dir.empty() && config.rig.kind != semap::onboard::RigKind::kSim) {
     std::cerr << "semap-onboard: --report needs the simulated rig (rig.kind: sim)\n";
     return 2;
   }
@@ -495,7 +603,7 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
-    return run(config, report_dir);
+    return run(config, options);
   } catch (const std::exception& e) {
     std::cerr << "semap-onboard: " << e.what() << "\n";
     return 1;

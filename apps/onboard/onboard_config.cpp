@@ -24,7 +24,17 @@ Eigen::Vector3f vector3(const ConfigSection& s, const std::string& key,
 }
 
 void read_rig(const ConfigSection& s, RigConfig& rig) {
-  rig.simulated = s.get_choice("kind", "sim", {"sim", "hardware"}) == "sim";
+  const std::string kind = s.get_choice("kind", "sim", {"sim", "hardware", "replay"});
+  rig.kind = kind == "sim"        ? RigKind::kSim
+             : kind == "hardware" ? RigKind::kHardware
+                                  : RigKind::kReplay;
+  rig.replay = s.get<std::string>("replay", "");
+  if (rig.kind == RigKind::kReplay && rig.replay.empty()) {
+    s.reject("replay", "rig.kind: replay needs the recording's directory");
+  }
+  rig.pace = s.get_choice("pace", "recorded", {"recorded", "fast"}) == "fast"
+                 ? ReplayPace::kFast
+                 : ReplayPace::kRecorded;
   rig.duration_s = s.get_in_range("duration_s", rig.duration_s, 0.0, 86400.0);
   auto& t = rig.trajectory;
   t.scenario = s.get_choice("scenario", "figure8", {"car", "figure8"}) == "car"
@@ -232,12 +242,12 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
     c.costmap = cc;
   }
   root.finish();
-  if (c.rig.simulated && c.depth.source != DepthSource::kAligned) {
+  if (c.rig.kind == RigKind::kSim && c.depth.source != DepthSource::kAligned) {
     throw common::ConfigError(path.string() +
                               ": key 'depth.source': the simulated rig renders aligned depth only");
   }
   if (!c.rig.camera_output.empty()) {
-    if (!c.rig.simulated) {
+    if (c.rig.kind != RigKind::kSim) {
       root.section("rig").reject("camera_output", "only the simulated rig writes camera frames");
     }
     // The frames come back at the device's capture rate, each one repeated until the next; a

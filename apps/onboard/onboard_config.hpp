@@ -22,10 +22,19 @@
 
 namespace semap::onboard {
 
-// The built-in simulated sensor rig (rig.kind: sim).
+// Where the sensor streams come from (rig.kind): the built-in simulated rig, the robot's
+// devices, or a recording made with --record played back (ReplayRig).
+enum class RigKind : std::uint8_t { kSim, kHardware, kReplay };
+// How a replay is paced: at the recorded rate, or as fast as the pipeline takes it (each frame
+// waits until the stages have taken everything before it, so the run is deterministic).
+enum class ReplayPace : std::uint8_t { kRecorded, kFast };
+
+// The sensor rig; the rest of the keys describe the built-in simulated rig (rig.kind: sim).
 struct RigConfig {
-  bool simulated = true;
-  double duration_s = 40.0;  // 0: run until SIGINT
+  RigKind kind = RigKind::kSim;
+  std::filesystem::path replay;  // rig.replay: the directory semap-onboard --record wrote
+  ReplayPace pace = ReplayPace::kRecorded;
+  double duration_s = 40.0;  // 0: run until SIGINT (a replay ends with its recording)
   estimation::SimulatorConfig trajectory;
   std::uint32_t scene_seed = 7;  // the street world and the camera's noise
   double world_density = 1.0;    // scales the number of buildings, trees, cars and poles

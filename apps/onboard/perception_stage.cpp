@@ -99,11 +99,13 @@ bool PerceptionStage::take_frames() {
   bool any = false;
   common::ImageFrame frame;
   while (colour_ring_.try_pop(frame)) {
+    if (tap_) tap_(frame, false);
     colour_pending_.push_back(std::move(frame));
     ++stage_.figures().frames;
     any = true;
   }
   while (depth_ring_ && depth_ring_->try_pop(frame)) {
+    if (tap_) tap_(frame, true);
     depth_pending_.push_back(std::move(frame));
     any = true;
   }

@@ -60,6 +60,10 @@ class PerceptionStage {
       std::function<void(std::uint32_t sequence, common::Stamp stamp, const cv::Mat& bgr,
                          const perception::Segmentation&)>;
   void set_observer(SegmentationObserver observer) { observer_ = std::move(observer); }
+  // Sees every frame taken from the rings, colour and depth, on the stage's thread (a
+  // recorder). Set before start().
+  using FrameTap = std::function<void(const common::ImageFrame&, bool depth)>;
+  void set_frame_tap(FrameTap tap) { tap_ = std::move(tap); }
 
   void start();
   void stop();
@@ -93,6 +97,7 @@ class PerceptionStage {
   DepthConfig depth_;
   std::unique_ptr<perception::Segmenter> segmenter_;
   SegmentationObserver observer_;
+  FrameTap tap_;
   std::unique_ptr<perception::StereoDepth> stereo_;
   common::SpscRing<common::ImageFrame>& colour_ring_;
   common::SpscRing<common::ImageFrame>* depth_ring_;

@@ -1,18 +1,11 @@
 #include "sim_rig.hpp"
 
-#include <fcntl.h>
-#include <pty.h>
-#include <termios.h>
-#include <unistd.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <array>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 
+#include "rig_clock.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/drivers/frame_convert.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
@@ -44,16 +37,6 @@ std::vector<Eigen::Vector3d> path_of(const estimation::SimulationData& data) {
   return path;
 }
 
-void sleep_until(common::Stamp when, std::stop_token stop) {
-  while (!stop.stop_requested()) {
-    const common::Stamp now = common::Stamp::now();
-    if (now >= when) return;
-    const auto wait = std::min<std::int64_t>(when.ns - now.ns, 20'000'000);
-    const timespec ts = common::Stamp(wait).to_timespec();
-    nanosleep(&ts, nullptr);
-  }
-}
-
 }  // namespace
 
 SimRig::SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>& imu_ring,
@@ -63,7 +46,8 @@ SimRig::SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>&
       imu_ring_(imu_ring),
       data_(simulate_drive(config)),
       world_(path_of(data_), world_options(config.rig)),
-      body_from_optical_(config.camera.body_from_optical()) {
+      body_from_optical_(config.camera.body_from_optical()),
+      busless_decoder_(config.imu.driver.decoder) {
   perception::SimCameraOptions camera;
   camera.intrinsics = config.camera.intrinsics;
   camera.seed = config.rig.scene_seed;
@@ -93,36 +77,31 @@ SimRig::SimRig(const OnboardConfig& config, common::SpscRing<common::ImuSample>&
   emu.gnss_protocol = config.gnss.protocol;
   emu.speed = 0.0;  // the rig paces events itself
   if (config.gnss.device == "pty") {
-    int slave = -1;
-    if (openpty(&pty_master_, &slave, nullptr, nullptr, nullptr) != 0) {
-      throw std::runtime_error(std::string("sim rig: openpty failed: ") + std::strerror(errno));
-    }
-    // Raw from the start, so nothing is echoed back before the driver configures the port.
-    termios tio{};
-    tcgetattr(slave, &tio);
-    cfmakeraw(&tio);
-    tcsetattr(slave, TCSANOW, &tio);
-    pty_slave_ = ttyname(slave);
-    // Keep the slave open so the master never sees a hang-up between driver reconnects.
-    pty_slave_fd_ = slave;
-    fcntl(pty_master_, F_SETFL, fcntl(pty_master_, F_GETFL) | O_NONBLOCK);
-    emu.serial_fd = pty_master_;
+    pty_ = std::make_unique<PseudoTerminal>();
+    pty_slave_ = pty_->slave_name();
+    emu.serial_fd = pty_->master();
+  }
+  // The IMU speaks the configured profile, on the bus or without one.
+  const auto& decoder = config.imu.driver.decoder;
+  emu.imu_profile = decoder.profile;
+  emu.base_id = decoder.base_id;
+  if (decoder.j1939_source != SEMAP_J1939_ADDRESS_ANY) {
+    emu.j1939_source = static_cast<std::uint8_t>(decoder.j1939_source);
   }
   if (!config.imu.interface.empty()) {
     can_socket_ = std::make_unique<firmware_bridge::CanSocket>(config.imu.interface, false);
     emu.can_fd = can_socket_->fd();
+  } else {
+    emu.can_sink = [this](const SemapCanFrame& frame) { busless_frame(frame); };
   }
   emulator_ = std::make_unique<firmware_bridge::Emulator>(emu);
 }
 
-SimRig::~SimRig() {
-  stop();
-  if (pty_slave_fd_ >= 0) ::close(pty_slave_fd_);
-  if (pty_master_ >= 0) ::close(pty_master_);
-}
+SimRig::~SimRig() { stop(); }
 
 void SimRig::start() {
-  start_ = common::Stamp::now() + 0.2;
+  // Whole microseconds, the resolution of a candump log: a recorded run replays exactly.
+  start_ = common::Stamp(((common::Stamp::now() + 0.2).ns / 1000) * 1000);
   camera_->start();
   thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
 }
@@ -155,6 +134,11 @@ void SimRig::request_frame(common::Stamp sim_stamp) {
   camera_->request(world_from_body * body_from_optical_, common::Stamp(start_.ns + truth.stamp.ns));
 }
 
+void SimRig::busless_frame(const SemapCanFrame& frame) {
+  if (can_tap_) can_tap_(busless_stamp_, frame);
+  if (auto sample = busless_decoder_.push(frame, busless_stamp_)) imu_ring_.try_push(*sample);
+}
+
 void SimRig::run(std::stop_token stop) {
   auto log = common::logger("sim_rig");
   const double duration = config_.rig.duration_s > 0 ? config_.rig.duration_s : 1e12;
@@ -172,20 +156,15 @@ void SimRig::run(std::stop_token stop) {
     if (sim_stamp.seconds() > duration) break;
     const common::Stamp wall(start_.ns + sim_stamp.ns);
     sleep_until(wall, stop);
-    if (auto* imu = std::get_if<common::ImuSample>(&*event)) {
-      if (can_socket_) {
-        emulator_->emit(*event);
-      } else {
-        common::ImuSample restamped = *imu;
-        restamped.stamp = wall;
-        imu_ring_.try_push(restamped);
-      }
+    if (std::holds_alternative<common::ImuSample>(*event)) {
+      busless_stamp_ = wall;
+      emulator_->emit(*event);
       ++imu_index;
       if (sim_stamp.seconds() + camera_ahead >= next_camera) {
         request_frame(common::Stamp::from_seconds(next_camera));
         next_camera += camera_period;
       }
-    } else if (pty_master_ >= 0) {
+    } else if (pty_) {
       emulator_->emit(*event);
     }
   }

@@ -1,10 +1,12 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <thread>
 
 #include "onboard_config.hpp"
+#include "pseudo_terminal.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/estimation/simulator.hpp"
@@ -17,12 +19,12 @@ namespace semap::onboard {
 
 // The built-in simulated sensor rig. It plays a simulated drive in real time: GNSS as NMEA/UBX
 // bytes into a pseudo-terminal (read by the real GnssDriver through termios), IMU as CAN
-// frames on a SocketCAN interface when one is configured (read by the real CanImuDriver) or
-// straight into the IMU ring otherwise, and camera frames of a synthetic world seen from the
-// true pose in a procedural street world (SimWorld): a colour frame, rendered or painted in
-// class colours (rig.camera_image), and an aligned Z16 depth frame, into the rings a colour
-// camera driver and a depth camera driver would fill (SimCameraFeed), or the colour frame to a
-// V4L2 output device (rig.camera_output) looped back to the capture device a real
+// frames on a SocketCAN interface when one is configured (read by the real CanImuDriver) or,
+// without a bus, through the same CAN encoder and decoder into the IMU ring, and camera frames of a
+// synthetic world seen from the true pose in a procedural street world (SimWorld): a colour frame,
+// rendered or painted in class colours (rig.camera_image), and an aligned Z16 depth frame, into the
+// rings a colour camera driver and a depth camera driver would fill (SimCameraFeed), or the colour
+// frame to a V4L2 output device (rig.camera_output) looped back to the capture device a real
 // CameraDriver reads. Sensor stamps are CLOCK_MONOTONIC, as real drivers would give them.
 class SimRig {
  public:
@@ -35,6 +37,10 @@ class SimRig {
 
   // Path of the pty slave the GNSS driver should open (empty when GNSS is not on a pty).
   const std::string& gnss_device() const { return pty_slave_; }
+  // Without a bus, sees each IMU frame with its stamp as a CanImuDriver's tap would (a
+  // recorder). Set before start().
+  using CanTap = std::function<void(common::Stamp, const SemapCanFrame&)>;
+  void set_can_tap(CanTap tap) { can_tap_ = std::move(tap); }
 
   void start();
   void stop();
@@ -50,6 +56,7 @@ class SimRig {
  private:
   void run(std::stop_token stop);
   void request_frame(common::Stamp sim_stamp);
+  void busless_frame(const SemapCanFrame& frame);
 
   const OnboardConfig& config_;
   common::SpscRing<common::ImuSample>& imu_ring_;
@@ -57,10 +64,12 @@ class SimRig {
   perception::SimWorld world_;
   std::unique_ptr<SimCameraFeed> camera_;
   Eigen::Isometry3f body_from_optical_;
-  int pty_master_ = -1;
-  int pty_slave_fd_ = -1;
+  std::unique_ptr<PseudoTerminal> pty_;
   std::unique_ptr<firmware_bridge::CanSocket> can_socket_;
   std::string pty_slave_;
+  firmware_bridge::CanImuDecoder busless_decoder_;
+  common::Stamp busless_stamp_;  // the stamp of the IMU sample being sent without a bus
+  CanTap can_tap_;
   std::unique_ptr<firmware_bridge::Emulator> emulator_;
   common::Stamp start_;
   std::atomic<bool> finished_{false};

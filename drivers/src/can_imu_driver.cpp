@@ -43,6 +43,7 @@ void CanImuDriver::service_device(std::stop_token /*stop*/) {
     const CanRead read = socket_->receive(i == 0 ? config_.poll_timeout_ms : 0, rx);
     if (read == CanRead::kTimeout) break;
     const auto now = std::chrono::steady_clock::now();
+    if (tap_) tap_(rx, read);
     if (read == CanRead::kError) {
       if (rx.error.state) apply(bus_.observe(*rx.error.state, now));
       continue;

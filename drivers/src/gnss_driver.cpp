@@ -46,6 +46,7 @@ void GnssDriver::service_device(std::stop_token /*stop*/) {
   // and at 115200 baud a sentence takes < 8 ms on the wire.
   const common::Stamp stamp = common::Stamp::now();
   counters().add_bytes(n);
+  if (tap_) tap_(stamp, std::span<const std::uint8_t>(buffer_.data(), n));
   fixes_.clear();
   decoder_->feed(std::span<const std::uint8_t>(buffer_.data(), n), stamp, fixes_);
   for (auto& fix : fixes_) deliver(ring_, std::move(fix));

@@ -76,7 +76,7 @@ void Emulator::emit(const SensorEvent& event) {
     have_first_ = true;
   }
   if (const auto* imu = std::get_if<common::ImuSample>(&event)) {
-    if (config_.can_fd >= 0) emit_imu(*imu);
+    if (config_.can_fd >= 0 || config_.can_sink) emit_imu(*imu);
   } else if (config_.serial_fd >= 0) {
     emit_gnss(std::get<common::GnssFix>(event));
   }
@@ -150,7 +150,10 @@ void Emulator::emit_imu(const common::ImuSample& sample) {
 }
 
 void Emulator::send_can(const SemapCanFrame& frame) {
-  if (write_can_frame(config_.can_fd, frame)) {
+  if (config_.can_sink) {
+    config_.can_sink(frame);
+    ++stats_.can_frames;
+  } else if (write_can_frame(config_.can_fd, frame)) {
     ++stats_.can_frames;
   } else {
     ++stats_.can_write_failures;

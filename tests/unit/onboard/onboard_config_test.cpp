@@ -42,7 +42,7 @@ std::string error_of(const std::filesystem::path& path) {
 
 TEST(OnboardConfig, SimulatedRigExample) {
   const auto c = load_onboard_config(kConfigDir / "sim.yaml");
-  EXPECT_TRUE(c.rig.simulated);
+  EXPECT_EQ(c.rig.kind, RigKind::kSim);
   EXPECT_EQ(c.camera.intrinsics.width, 640);
   EXPECT_EQ(c.camera.intrinsics.height, 480);
   EXPECT_DOUBLE_EQ(c.camera.driver.fps, 15.0);
@@ -60,7 +60,7 @@ TEST(OnboardConfig, SimulatedRigExample) {
 
 TEST(OnboardConfig, RgbdRobotExample) {
   const auto c = load_onboard_config(kConfigDir / "robot-rgbd.yaml");
-  EXPECT_FALSE(c.rig.simulated);
+  EXPECT_EQ(c.rig.kind, RigKind::kHardware);
   EXPECT_EQ(c.camera.driver.device, "/dev/video0");
   EXPECT_EQ(c.camera.driver.format, common::PixelFormat::kYuyv);
   EXPECT_FLOAT_EQ(c.camera.intrinsics.fx, 615.0f);

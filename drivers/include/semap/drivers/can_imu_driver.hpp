@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -46,6 +47,11 @@ class CanImuDriver : public DriverRunner {
   // The controller's state as last seen (error-active until an error frame or poll says else).
   CanBusState bus_state() const { return bus_state_.load(std::memory_order_acquire); }
 
+  // Sees every frame received, error frames included, on the driver's thread (a recorder).
+  // Set before start().
+  using FrameTap = std::function<void(const CanRxFrame&, CanRead)>;
+  void set_frame_tap(FrameTap tap) { tap_ = std::move(tap); }
+
  protected:
   void open_device() override;
   void service_device(std::stop_token stop) override;
@@ -64,6 +70,7 @@ class CanImuDriver : public DriverRunner {
   CanBusMonitor bus_;
   std::atomic<CanBusState> bus_state_{CanBusState::kErrorActive};
   std::chrono::steady_clock::time_point next_state_poll_{};
+  FrameTap tap_;
   std::uint32_t socket_drops_ = 0;  // SO_RXQ_OVFL total of the current socket
   firmware_bridge::CanImuCounters published_{};
   mutable std::mutex counters_mutex_;

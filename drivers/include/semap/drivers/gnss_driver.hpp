@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -31,6 +32,11 @@ class GnssDriver : public DriverRunner {
   // Per-kind counters summed over every connection.
   firmware_bridge::GnssStreamCounters stream_counters() const;
 
+  // Sees every read's bytes with their read stamp, on the driver's thread (a recorder). Set
+  // before start().
+  using ByteTap = std::function<void(common::Stamp, std::span<const std::uint8_t>)>;
+  void set_byte_tap(ByteTap tap) { tap_ = std::move(tap); }
+
  protected:
   void open_device() override;
   void service_device(std::stop_token stop) override;
@@ -45,6 +51,7 @@ class GnssDriver : public DriverRunner {
   std::unique_ptr<firmware_bridge::GnssStreamDecoder> decoder_;
   std::vector<common::GnssFix> fixes_;
   std::vector<std::uint8_t> buffer_;
+  ByteTap tap_;
   firmware_bridge::GnssStreamCounters closed_{};     // sums of earlier connections
   firmware_bridge::GnssStreamCounters published_{};  // totals at the last publish
   mutable std::mutex counters_mutex_;

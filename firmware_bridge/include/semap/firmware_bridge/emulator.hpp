@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <random>
 
 #include "semap/firmware_bridge/can_imu_decoder.hpp"
@@ -58,6 +59,8 @@ struct EmulatorStats {
 
 struct EmulatorConfig {
   int can_fd = -1;  // CAN_RAW socket (or any datagram socket); -1: no IMU output
+  // Without a socket: each frame is handed here instead (a CAN link without a bus).
+  std::function<void(const SemapCanFrame&)> can_sink;
   ImuProfile imu_profile = ImuProfile::kSemap;
   bool can_fd_frames = false;  // semap profile: one 64-byte FD frame per sample
   std::uint32_t base_id = SEMAP_CAN_IMU_DEFAULT_BASE_ID;
