@@ -585,6 +585,23 @@ int main(int argc, char** argv) {
         pace == "fast" ? semap::onboard::ReplayPace::kFast : semap::onboard::ReplayPace::kRecorded;
   }
   if (!save_path.empty()) config.map.save_path = save_path;
+  // What the configuration names on this machine, checked before anything starts: a map that
+  // cannot be saved at exit would be lost.
+  if (config.dds.enabled && !config.dds.cyclone_config.empty() &&
+      !std::filesystem::is_regular_file(config.dds.cyclone_config)) {
+    std::cerr << "semap-onboard: " << config_path
+              << ": dds.config: " << config.dds.cyclone_config.string() << ": no such file\n";
+    return 2;
+  }
+  if (const auto dir = std::filesystem::path(config.map.save_path).parent_path(); !dir.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(dir, error);
+    if (error) {
+      std::cerr << "semap-onboard: map.save_path: cannot create " << dir.string() << ": "
+                << error.message() << "\n";
+      return 2;
+    }
+  }
   if (!options.record_dir.empty() && config.rig.kind == semap::onboard::RigKind::kReplay) {
     std::cerr << "semap-onboard: --record cannot record a replay\n";
     return 2;

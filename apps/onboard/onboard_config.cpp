@@ -16,9 +16,7 @@ Eigen::Vector3f vector3(const ConfigSection& s, const std::string& key,
                         const Eigen::Vector3f& fallback) {
   if (!s.has(key)) return fallback;
   const auto v = s.get<std::vector<double>>(key);
-  if (v.size() != 3)
-    throw common::ConfigError(s.file() + ": key '" + s.path() + "." + key +
-                              "': expected 3 numbers");
+  if (v.size() != 3) s.reject(key, "expected 3 numbers, got " + std::to_string(v.size()));
   return Eigen::Vector3f(static_cast<float>(v[0]), static_cast<float>(v[1]),
                          static_cast<float>(v[2]));
 }
@@ -31,6 +29,9 @@ void read_rig(const ConfigSection& s, RigConfig& rig) {
   rig.replay = s.get<std::string>("replay", "");
   if (rig.kind == RigKind::kReplay && rig.replay.empty()) {
     s.reject("replay", "rig.kind: replay needs the recording's directory");
+  }
+  if (rig.kind == RigKind::kReplay && !std::filesystem::is_directory(rig.replay)) {
+    s.reject("replay", rig.replay.string() + " is not a directory");
   }
   rig.pace = s.get_choice("pace", "recorded", {"recorded", "fast"}) == "fast"
                  ? ReplayPace::kFast
@@ -66,9 +67,12 @@ void read_imu(const ConfigSection& s, ImuSourceConfig& imu) {
 }
 
 void read_gnss(const ConfigSection& s, GnssSourceConfig& gnss) {
-  gnss.device = s.get<std::string>("device", "pty");
-  gnss.driver.serial.device = gnss.device;
-  gnss.driver.serial.baud = s.get<int>("baud", 115200);
+  // The driver's keys (device, baud, vmin, vtime, uere_m, reconnect_*) as the driver documents
+  // them; device "pty" means the simulated rig's pseudo-terminal.
+  const bool has_device = s.has("device");
+  gnss.driver = drivers::gnss_config(s);
+  if (!has_device) gnss.driver.serial.device = "pty";
+  gnss.device = gnss.driver.serial.device;
   gnss.protocol = s.get_choice("protocol", "nmea", {"nmea", "ubx"}) == "ubx"
                       ? firmware_bridge::GnssProtocol::kUbx
                       : firmware_bridge::GnssProtocol::kNmea;
@@ -81,8 +85,7 @@ std::size_t ring_size(const ConfigSection& s, std::size_t fallback) {
   const auto n =
       static_cast<std::size_t>(s.get_in_range("ring", static_cast<double>(fallback), 2, 65536));
   if ((n & (n - 1)) != 0) {
-    throw common::ConfigError(s.file() + ": key '" + s.path() + ".ring': " + std::to_string(n) +
-                              " is not a power of two");
+    s.reject("ring", std::to_string(n) + " is not a power of two");
   }
   return n;
 }
@@ -117,19 +120,18 @@ void read_depth(const ConfigSection& s, const CameraConfig& camera, DepthConfig&
     depth.driver = drivers::camera_config(s);
     if (!s.has("format")) depth.driver.format = common::PixelFormat::kZ16;
     if (depth.driver.format != common::PixelFormat::kZ16) {
-      throw common::ConfigError(s.file() + ": key '" + s.path() +
-                                ".format': an aligned depth device delivers Z16");
+      s.reject("format", "an aligned depth device delivers Z16");
     }
     // Aligned means pixel for pixel: the size and rate are the colour camera's unless set.
     if (!s.has("width")) depth.driver.width = camera.driver.width;
     if (!s.has("height")) depth.driver.height = camera.driver.height;
     if (!s.has("fps")) depth.driver.fps = camera.driver.fps;
     if (depth.driver.width != camera.driver.width || depth.driver.height != camera.driver.height) {
-      throw common::ConfigError(
-          s.file() + ": key '" + s.path() + ".width/height': aligned depth of " +
-          std::to_string(depth.driver.width) + "x" + std::to_string(depth.driver.height) +
-          " does not match the camera's " + std::to_string(camera.driver.width) + "x" +
-          std::to_string(camera.driver.height));
+      s.reject(depth.driver.width != camera.driver.width ? "width" : "height",
+               "aligned depth of " + std::to_string(depth.driver.width) + "x" +
+                   std::to_string(depth.driver.height) + " does not match the camera's " +
+                   std::to_string(camera.driver.width) + "x" +
+                   std::to_string(camera.driver.height));
     }
     depth.depth_scale =
         static_cast<float>(s.get_in_range("depth_scale", depth.depth_scale, 1e-6, 1.0));
@@ -137,16 +139,18 @@ void read_depth(const ConfigSection& s, const CameraConfig& camera, DepthConfig&
         s.get_in_range("sync_tolerance_ms", 1e3 * depth.sync_tolerance_s, 0.0, 1000.0) / 1e3;
   } else {
     depth.stereo_calibration = std::filesystem::absolute(s.get<std::string>("calibration"));
+    if (!std::filesystem::is_regular_file(depth.stereo_calibration)) {
+      s.reject("calibration", depth.stereo_calibration.string() + ": no such file");
+    }
     depth.stereo.num_disparities =
         static_cast<int>(s.get_in_range("num_disparities", depth.stereo.num_disparities, 16, 512));
     if (depth.stereo.num_disparities % 16 != 0) {
-      throw common::ConfigError(s.file() + ": key '" + s.path() +
-                                ".num_disparities': must be a multiple of 16");
+      s.reject("num_disparities", "must be a multiple of 16");
     }
     depth.stereo.block_size =
         static_cast<int>(s.get_in_range("block_size", depth.stereo.block_size, 1, 31));
     if (depth.stereo.block_size % 2 == 0) {
-      throw common::ConfigError(s.file() + ": key '" + s.path() + ".block_size': must be odd");
+      s.reject("block_size", "must be odd");
     }
   }
   auto& p = depth.points;
@@ -165,6 +169,9 @@ void read_segmenter(const ConfigSection& s, SegmenterConfig& seg) {
                  : SegmenterConfig::Kind::kPalette;
   if (seg.kind == SegmenterConfig::Kind::kOnnx) {
     seg.model_card = std::filesystem::absolute(s.get<std::string>("model_card"));
+    if (!std::filesystem::is_regular_file(seg.model_card)) {
+      s.reject("model_card", seg.model_card.string() + ": no such file");
+    }
   } else {
     if (s.has("palette")) seg.palette = std::filesystem::absolute(s.get<std::string>("palette"));
     seg.confidence = static_cast<float>(s.get_in_range("confidence", seg.confidence, 0.01, 1.0));
@@ -243,8 +250,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   }
   root.finish();
   if (c.rig.kind == RigKind::kSim && c.depth.source != DepthSource::kAligned) {
-    throw common::ConfigError(path.string() +
-                              ": key 'depth.source': the simulated rig renders aligned depth only");
+    root.section_or_empty("depth").reject("source", "the simulated rig renders aligned depth only");
   }
   if (!c.rig.camera_output.empty()) {
     if (c.rig.kind != RigKind::kSim) {

@@ -7,7 +7,7 @@ namespace {
 
 int get_int(const common::ConfigSection& s, const std::string& key, int fallback, int lo, int hi) {
   const double v = s.get_in_range(key, fallback, lo, hi);
-  if (v != std::floor(v)) throw common::ConfigError(s.file() + ": " + key + " must be an integer");
+  if (v != std::floor(v)) s.reject(key, "must be an integer");
   return static_cast<int>(v);
 }
 
@@ -43,11 +43,14 @@ CanImuConfig can_imu_config(const common::ConfigSection& imu) {
 GnssConfig gnss_config(const common::ConfigSection& gnss) {
   GnssConfig c;
   c.serial.device = gnss.get<std::string>("device", c.serial.device);
+  if (c.serial.device.empty()) gnss.reject("device", "must name the receiver's serial device");
   c.serial.baud = get_int(gnss, "baud", c.serial.baud, 1, 4'000'000);
   try {
     baud_constant(c.serial.baud);
-  } catch (const std::invalid_argument& e) {
-    throw common::ConfigError(gnss.file() + ": baud: " + e.what());
+  } catch (const std::invalid_argument&) {
+    gnss.reject("baud", std::to_string(c.serial.baud) +
+                            " is not a supported rate (4800, 9600, 19200, 38400, 57600, 115200, "
+                            "230400, 460800, 921600)");
   }
   c.serial.vmin = get_int(gnss, "vmin", c.serial.vmin, 0, 255);
   c.serial.vtime = get_int(gnss, "vtime", c.serial.vtime, 0, 255);

@@ -14,7 +14,7 @@ Eigen::Vector3d vector3(const common::ConfigSection& s, const std::string& key,
                         const Eigen::Vector3d& fallback) {
   if (!s.has(key)) return fallback;
   const auto v = s.get<std::vector<double>>(key);
-  if (v.size() != 3) throw common::ConfigError(s.file() + ": " + key + " needs 3 values");
+  if (v.size() != 3) s.reject(key, "expected 3 numbers, got " + std::to_string(v.size()));
   return {v[0], v[1], v[2]};
 }
 
@@ -70,7 +70,7 @@ EstimatorConfig load_estimator_config(const common::ConfigSection& s) {
   if (s.has("anchor")) {
     const Eigen::Vector3d a = vector3(s, "anchor", Eigen::Vector3d::Zero());
     if (std::abs(a.x()) > 90.0 || std::abs(a.y()) > 180.0) {
-      throw common::ConfigError(s.file() + ": anchor must be [lat_deg, lon_deg, alt_m]");
+      s.reject("anchor", "must be [lat_deg, lon_deg, alt_m] with |lat| <= 90 and |lon| <= 180");
     }
     c.anchor = Geodetic{a.x(), a.y(), a.z()};
   }

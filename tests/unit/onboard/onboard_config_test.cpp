@@ -148,16 +148,75 @@ TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
             std::string::npos);
   EXPECT_NE(error_of(edited_sim("source: aligned", "source: stereo")).find("depth.calibration"),
             std::string::npos);
-  EXPECT_NE(error_of(edited_sim("source: aligned\n  depth_scale: 0.001",
-                                "source: stereo\n  calibration: x.yaml"))
-                .find("the simulated rig renders aligned depth only"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(edited_sim("source: aligned\n  depth_scale: 0.001",
+                          "source: stereo\n  calibration: config/stereo-calibration-example.yaml"))
+          .find("the simulated rig renders aligned depth only"),
+      std::string::npos);
   EXPECT_NE(error_of(edited_sim("  model_card: models/semap-seg.yaml\n", ""))
                 .find("segmenter.model_card"),
             std::string::npos);
   EXPECT_NE(
       error_of(edited_sim("kind: onnx ", "colour: red\n  kind: onnx ")).find("segmenter.colour"),
       std::string::npos);
+}
+
+// One bad value per key: start-up stops with `file:line: key 'section.key': why`, the line being
+// the bad key's in the edited file.
+TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
+  struct Case {
+    std::string replace, with;
+    std::string key;  // as the message names it
+    std::string why;  // part of the reason
+  };
+  const std::vector<Case> cases{
+      {"  baud: 115200", "  baud: 12345", "gnss.baud", "12345 is not a supported rate"},
+      {"  baud: 115200", "  baud: 115200.5", "gnss.baud", "must be an integer"},
+      {"  device: pty", "  device: \"\"", "gnss.device", "must name the receiver's serial device"},
+      {"  protocol: nmea", "  protocol: sirf", "gnss.protocol", "sirf"},
+      {"  lever_arm: [0, 0, 0]", "  lever_arm: [0, 0]", "gnss.lever_arm", "expected 3 numbers"},
+      {"  profile: semap", "  profile: j1939\n  j1939_source: 254", "imu.j1939_source", "254"},
+      {"  ring: 4096", "  ring: 8", "imu.ring", "out of range"},
+      {"  kind: sim", "  kind: bag", "rig.kind", "bag"},
+      {"  kind: sim", "  kind: replay", "rig.replay", "needs the recording's directory"},
+      {"  kind: sim", "  kind: replay\n  replay: /nonexistent/run", "rig.replay",
+       "is not a directory"},
+      {"  kind: sim", "  kind: sim\n  pace: slow", "rig.pace", "slow"},
+      {"  speed_m_s: 5", "  speed_m_s: 90", "rig.speed_m_s", "out of range"},
+      {"  fps: 15", "  fps: 0", "camera.fps", "out of range"},
+      {"  mount_xyz: [0.3, 0, 1.5]", "  mount_xyz: [0.3]", "camera.mount_xyz",
+       "expected 3 numbers, got 1"},
+      {"  source: aligned", "  source: aligned\n  format: YUYV", "depth.format", "delivers Z16"},
+      {"  source: aligned", "  source: aligned\n  width: 64", "depth.width",
+       "aligned depth of 64x480 does not match the camera's 640x480"},
+      {"  source: aligned\n", "  source: stereo\n  calibration: /nonexistent/stereo.yaml\n",
+       "depth.calibration", "no such file"},
+      {"  model_card: models/semap-seg.yaml", "  model_card: models/missing.yaml",
+       "segmenter.model_card", "no such file"},
+      {"  gating_probability: 0.999", "  gating_probability: 0.999\n  anchor: [91, 0, 0]",
+       "estimator.anchor", "|lat| <= 90"},
+      {"  resolution: 0.2\n  block_depth", "  resolution: -1\n  block_depth", "map.resolution", ""},
+      {"  checkpoint_s: 10", "  checkpoint_s: -1", "map.checkpoint_s", "out of range"},
+      {"  domain: 0", "  domain: 300", "dds.domain", "out of range"},
+      {"  publish_hz: 2\n  cloud_hz", "  publish_hz: 0\n  cloud_hz", "dds.publish_hz",
+       "out of range"},
+  };
+  for (const Case& c : cases) {
+    const auto path = edited_sim(c.replace, c.with);
+    std::ifstream in(path);
+    const std::string text((std::istreambuf_iterator<char>(in)), {});
+    // The bad key's line in the edited text; a missing key is reported at its section's.
+    const auto edit = text.find(c.with);
+    ASSERT_NE(edit, std::string::npos) << c.with;
+    auto at = text.find("  " + c.key.substr(c.key.find('.') + 1) + ":", edit);
+    if (at == std::string::npos) at = edit;
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
+    const std::string error = error_of(path);
+    const std::string named =
+        path.string() + ":" + std::to_string(line) + ": key '" + c.key + "': ";
+    EXPECT_EQ(error.rfind(named, 0), 0u) << "want " << named << "\ngot  " << error;
+    EXPECT_NE(error.find(c.why), std::string::npos) << error;
+  }
 }
 
 TEST(OnboardConfig, SegmenterMustFitTheMap) {
