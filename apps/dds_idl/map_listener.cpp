@@ -1,6 +1,9 @@
 // semap-map-listener: follows one robot's map (and pose) over DDS, prints what arrives and can
 // save the received map.
 #include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <thread>
 
@@ -41,6 +44,7 @@ int main(int argc, char** argv) {
   dds.add_flags(app);
   std::string config_path;
   std::string save_path;
+  std::string odometry_path;
   double seconds = 0.0;
   std::size_t expect_blocks = 0;
   int num_classes = 0;
@@ -49,6 +53,9 @@ int main(int argc, char** argv) {
   app.add_option("--config", config_path, "semap YAML; its dds: section is used")
       ->check(CLI::ExistingFile);
   app.add_option("--save", save_path, "write the received map as PCD (x y z class variance)");
+  app.add_option("--odometry", odometry_path,
+                 "write every odometry sample received as CSV: stamp_s,x,y,z (the header's stamp "
+                 "on this machine's CLOCK_MONOTONIC)");
   app.add_option("--seconds", seconds, "stop after this long (0: until Ctrl-C)");
   app.add_option("--expect-blocks", expect_blocks, "stop once this many blocks arrived");
   app.add_option("--classes", num_classes, "reject blocks with another class count");
@@ -88,10 +95,25 @@ int main(int argc, char** argv) {
     auto next_report = start;
     std::uint64_t info_seen = 0;
     std::optional<sd::PoseEstimate> last_pose;
+    std::ofstream odometry_csv;
+    if (!odometry_path.empty()) {
+      odometry_csv.open(odometry_path);
+      if (!odometry_csv)
+        throw std::runtime_error("--odometry " + odometry_path + ": cannot create");
+      odometry_csv << "stamp_s,x,y,z\n";
+    }
     while (!semap::apps::stop_requested()) {
       client.wait_for_blocks(SIZE_MAX, std::chrono::milliseconds(100));
       odom.take_each([&](const sd::msg::Odometry& m, const dds_sample_info_t&) {
         last_pose = sd::from_msg(m);
+        if (odometry_csv.is_open()) {
+          const std::int64_t ns = last_pose->stamp.ns;
+          const Eigen::Vector3d& p = last_pose->position;
+          char line[128];
+          std::snprintf(line, sizeof line, "%" PRId64 ".%09" PRId64 ",%.6f,%.6f,%.6f\n",
+                        ns / 1'000'000'000, ns % 1'000'000'000, p.x(), p.y(), p.z());
+          odometry_csv << line << std::flush;
+        }
       });
       if (health_reader) {
         health_reader->take_each([](const sd::msg::Health& m, const dds_sample_info_t&) {

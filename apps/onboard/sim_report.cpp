@@ -1,6 +1,7 @@
 #include "sim_report.hpp"
 
 #include <algorithm>
+#include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -303,10 +304,27 @@ void SimReport::write_trajectory_png(std::optional<double> rmse) const {
   write_png(dir_ / "trajectory.png", out);
 }
 
+void SimReport::write_truth_csv(const EstimationStageStats& final) const {
+  if (!final.anchor) return;
+  const estimation::LocalEnu sim_frame(rig_.data().origin);
+  const Eigen::Vector3d sim_from_map = sim_frame.to_enu(*final.anchor) - final.anchor_offset;
+  std::ofstream out(dir_ / "truth.csv");
+  out << "stamp_s,x,y,z\n";
+  char line[128];
+  for (const auto& t : rig_.data().truth) {
+    const std::int64_t ns = rig_.started_at().ns + t.stamp.ns;
+    const Eigen::Vector3d p = t.state.position - sim_from_map;
+    std::snprintf(line, sizeof line, "%" PRId64 ".%09" PRId64 ",%.6f,%.6f,%.6f\n",
+                  ns / 1'000'000'000, ns % 1'000'000'000, p.x(), p.y(), p.z());
+    out << line;
+  }
+}
+
 std::filesystem::path SimReport::write(const RunFigures& run, const mapping::SemanticMap& map,
                                        const EstimationStageStats& final) const {
   write_camera_png();
   write_trajectory_png(run.pose_rmse_m);
+  write_truth_csv(final);
   const ClassConfusion cells = map_confusion(map, final);
   ClassConfusion pixels;
   {

@@ -67,6 +67,8 @@ struct RunFigures {
 
 // What semap-onboard --report DIR writes on the simulated rig: camera.png (one frame: what
 // the segmenter saw | its output | the true classes), trajectory.png (estimate vs truth),
+// truth.csv (the simulated truth in the map frame at every IMU stamp, `stamp_s,x,y,z` as
+// --trajectory writes the estimate, for a test to score the published poses itself),
 // summary.json (pose RMSE, pixel mIoU of the segmenter, mIoU of the map's occupied cells
 // against the world's true class at each cell centre (and over the cells on a surface
 // alone), frame counts, latency, ring drops,
@@ -98,6 +100,7 @@ class SimReport {
                                const EstimationStageStats& final) const;
   void write_camera_png() const;
   void write_trajectory_png(std::optional<double> rmse) const;
+  void write_truth_csv(const EstimationStageStats& final) const;
 
   const SimRig& rig_;
   std::filesystem::path dir_;

@@ -46,6 +46,8 @@ class SimRig {
   void stop();
   bool finished() const { return finished_.load(std::memory_order_acquire); }
 
+  // CLOCK_MONOTONIC of the simulated drive's time zero (set by start()).
+  common::Stamp started_at() const { return start_; }
   // Truth at a monotonic stamp (nearest simulated sample), in the simulator's ENU frame.
   std::optional<estimation::TruthSample> truth_at(common::Stamp stamp) const;
   const estimation::SimulationData& data() const { return data_; }
