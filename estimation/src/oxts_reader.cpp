@@ -6,6 +6,7 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -73,32 +74,64 @@ std::optional<OxtsRecord> parse_oxts_line(std::string_view line, std::string& er
   return r;
 }
 
-std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text) {
+std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text, std::string& error) {
+  error.clear();
   while (!text.empty() && is_space(text.back())) text.remove_suffix(1);
   // YYYY-MM-DD HH:MM:SS[.fraction]
   if (text.size() < 19 || text[4] != '-' || text[7] != '-' || text[10] != ' ' || text[13] != ':' ||
       text[16] != ':') {
+    error = "not 'YYYY-MM-DD HH:MM:SS[.fraction]'";
     return std::nullopt;
   }
-  auto number = [&](std::size_t at, std::size_t len, int& out) {
-    const auto [ptr, ec] = std::from_chars(text.data() + at, text.data() + at + len, out);
-    return ec == std::errc() && ptr == text.data() + at + len;
+  struct Field {
+    const char* name;
+    std::size_t at, len;
+    int min, max;
+    int value = 0;
   };
-  int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
-  if (!number(0, 4, year) || !number(5, 2, month) || !number(8, 2, day) || !number(11, 2, hour) ||
-      !number(14, 2, minute) || !number(17, 2, second)) {
-    return std::nullopt;
+  // The year range keeps nanoseconds since 1970 within int64 (which ends in April 2262).
+  std::array<Field, 6> fields = {{{"year", 0, 4, kMinKittiYear, kMaxKittiYear},
+                                  {"month", 5, 2, 1, 12},
+                                  {"day", 8, 2, 1, 31},
+                                  {"hour", 11, 2, 0, 23},
+                                  {"minute", 14, 2, 0, 59},
+                                  {"second", 17, 2, 0, 60}}};
+  for (Field& f : fields) {
+    const char* begin = text.data() + f.at;
+    const char* end = begin + f.len;
+    const auto [ptr, ec] = std::from_chars(begin, end, f.value);
+    if (ec != std::errc() || ptr != end ||
+        !std::all_of(begin, end, [](char c) { return c >= '0' && c <= '9'; })) {
+      error = std::string(f.name) + " '" + std::string(begin, end) + "' is not a number";
+      return std::nullopt;
+    }
+    if (f.value < f.min || f.value > f.max) {
+      error = std::string(f.name) + " " + std::to_string(f.value) + " outside " +
+              std::to_string(f.min) + ".." + std::to_string(f.max);
+      return std::nullopt;
+    }
   }
-  if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60 ||
-      year < 1970) {
+  const int year = fields[0].value, month = fields[1].value, day = fields[2].value;
+  const bool leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+  constexpr std::array<int, 12> kDays = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  const int month_days = kDays[static_cast<std::size_t>(month - 1)] + (month == 2 && leap ? 1 : 0);
+  if (day > month_days) {
+    error = "day " + std::to_string(day) + " outside 1.." + std::to_string(month_days) +
+            " for month " + std::to_string(month);
     return std::nullopt;
   }
   std::int64_t nanos = 0;
   if (text.size() > 19) {
-    if (text[19] != '.' || text.size() > 29 || text.size() == 20) return std::nullopt;
+    if (text[19] != '.' || text.size() > 29 || text.size() == 20) {
+      error = "fraction must be '.' and 1 to 9 digits";
+      return std::nullopt;
+    }
     std::int64_t scale = 100000000;
     for (std::size_t i = 20; i < text.size(); ++i) {
-      if (text[i] < '0' || text[i] > '9') return std::nullopt;
+      if (text[i] < '0' || text[i] > '9') {
+        error = "fraction has a non-digit";
+        return std::nullopt;
+      }
       nanos += (text[i] - '0') * scale;
       scale /= 10;
     }
@@ -107,11 +140,22 @@ std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text) {
   tm.tm_year = year - 1900;
   tm.tm_mon = month - 1;
   tm.tm_mday = day;
-  tm.tm_hour = hour;
-  tm.tm_min = minute;
-  tm.tm_sec = second;
-  const std::time_t seconds = timegm(&tm);
-  return common::Stamp(static_cast<std::int64_t>(seconds) * 1'000'000'000 + nanos);
+  tm.tm_hour = fields[3].value;
+  tm.tm_min = fields[4].value;
+  tm.tm_sec = fields[5].value;
+  const std::int64_t seconds = static_cast<std::int64_t>(timegm(&tm));
+  constexpr std::int64_t kNs = 1'000'000'000;
+  // Within the year range this only trips in the last months of 2262.
+  if (seconds > (std::numeric_limits<std::int64_t>::max() - nanos) / kNs) {
+    error = "time beyond 2262-04-11 (nanoseconds since 1970 overflow int64)";
+    return std::nullopt;
+  }
+  return common::Stamp(seconds * kNs + nanos);
+}
+
+std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text) {
+  std::string error;
+  return parse_kitti_timestamp(text, error);
 }
 
 OxtsData read_oxts_folder(const std::filesystem::path& dir) {
@@ -139,10 +183,11 @@ OxtsData read_oxts_folder(const std::filesystem::path& dir) {
                            ": missing timestamp for " + file.filename().string());
       break;
     }
-    const auto stamp = parse_kitti_timestamp(line);
+    std::string stamp_error;
+    const auto stamp = parse_kitti_timestamp(line, stamp_error);
     if (!stamp) {
       out.errors.push_back(stamps_path.string() + ":" + std::to_string(line_no) +
-                           ": bad timestamp '" + line.substr(0, 40) + "'");
+                           ": bad timestamp '" + line.substr(0, 40) + "': " + stamp_error);
       continue;
     }
     std::ifstream in(file);

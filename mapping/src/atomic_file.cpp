@@ -1,6 +1,7 @@
 #include "semap/mapping/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -50,6 +51,8 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
   if (fd.get() < 0) fail(path, "creating temporary file", errno);
   const std::filesystem::path temp(name.data());
   try {
+    // Held until close: remove_stale_temporaries leaves a locked temporary alone.
+    if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) fail(temp, "flock", errno);
     // mkstemp creates 0600; a map is an ordinary document, readable like any other file.
     if (::fchmod(fd.get(), 0644) != 0) fail(temp, "fchmod", errno);
     std::size_t written = 0;
@@ -71,6 +74,34 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
   Fd dir_fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY));
   if (dir_fd.get() < 0) fail(dir, "open directory", errno);
   if (::fsync(dir_fd.get()) != 0) fail(dir, "fsync directory", errno);
+}
+
+std::size_t remove_stale_temporaries(const std::filesystem::path& path,
+                                     std::chrono::seconds min_age) {
+  const std::filesystem::path dir =
+      path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::string prefix(1, '.');
+  prefix.append(path.filename().string()).push_back('.');
+  std::error_code ec;
+  std::filesystem::directory_iterator it(dir, ec);
+  if (ec) return 0;
+  std::size_t removed = 0;
+  const auto now = std::filesystem::file_time_type::clock::now();
+  for (const auto& entry : it) {
+    const std::string name = entry.path().filename().string();
+    // mkstemp's names: the prefix and six characters.
+    if (name.size() != prefix.size() + 6 || name.compare(0, prefix.size(), prefix) != 0) continue;
+    std::error_code entry_ec;
+    if (!entry.is_regular_file(entry_ec)) continue;
+    const auto mtime = std::filesystem::last_write_time(entry.path(), entry_ec);
+    if (entry_ec || now - mtime < min_age) continue;
+    Fd fd(::open(entry.path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC));
+    if (fd.get() < 0) continue;
+    // A live writer holds the lock; a killed one released it with its descriptors.
+    if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) continue;
+    if (::unlink(entry.path().c_str()) == 0) ++removed;
+  }
+  return removed;
 }
 
 }  // namespace semap::mapping

@@ -253,13 +253,20 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
       if (result.map.find_layer(source) != nullptr) {
         r.fail_at(start, where + ": source " + std::to_string(source) + " appears twice");
       }
-      if (blocks > r.remaining() / block_record) {
-        r.fail_at(start, where + ": " + std::to_string(blocks) + " blocks cannot fit in the " +
-                             std::to_string(r.remaining()) + " bytes left");
+      // Every block record has this size, so a count that cannot fit means the file was cut
+      // inside this layer (the record's CRC vouches for the count). Salvage reads the blocks
+      // that are there before reporting it.
+      const std::size_t fit = r.remaining() / block_record;
+      std::optional<std::string> cut;
+      if (blocks > fit) {
+        cut = where + ": " + std::to_string(blocks) + " blocks cannot fit in the " +
+              std::to_string(r.remaining()) + " bytes left";
+        if (!options.salvage) r.fail_at(start, *cut);
       }
       EvidenceGrid& grid = result.map.layer(source);
       grid.set_updates(updates);
-      for (std::uint32_t b = 0; b < blocks; ++b) {
+      const std::uint32_t readable = cut ? static_cast<std::uint32_t>(fit) : blocks;
+      for (std::uint32_t b = 0; b < readable; ++b) {
         const std::size_t block_start = r.offset();
         const std::string block_where =
             where + " (source " + std::to_string(source) + ") block " + std::to_string(b);
@@ -289,6 +296,7 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
         grid.put_block(key, values);
         ++result.blocks;
       }
+      if (cut) r.fail_at(start, *cut);
     }
     const std::size_t footer = r.offset();
     if (r.get<std::uint32_t>("footer tag") != kFooterTag) r.fail_at(footer, "footer: bad tag");
@@ -308,6 +316,8 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
 }
 
 void write_smap(const std::filesystem::path& path, const LayeredMap& map, bool durable) {
+  // Temporaries of earlier writers to this path that were killed mid-write.
+  remove_stale_temporaries(path);
   write_file_atomically(path, encode_smap(map), durable);
 }
 

@@ -116,6 +116,42 @@ TEST_F(VividTest, Captures300YuyvFramesAtConfiguredRate) {
   EXPECT_EQ(driver.stats().checksum_failures, 0u);
 }
 
+// vivid's default test pattern is "75% Colorbar": eight vertical bars of width/8, in the order
+// of ITU-R BT.801 (v4l2-tpg-core.c, bars[0]): white, yellow, cyan, green, magenta, red, blue,
+// black, the coloured ones at 75% (R'G'B' 191 or 0). Sampled in the middle rows (the text
+// overlay is at the top), each bar must keep its colour channel by channel through the YUYV ->
+// BGR conversion: a U/V or R/B swap turns yellow into a blue or a cyan.
+TEST_F(VividTest, YuyvFrameShowsThe75PercentColourBars) {
+  SpscRing<ImageFrame> ring(8, common::OverflowPolicy::kDropOldest);
+  CameraDriver driver(config(PixelFormat::kYuyv), ring);
+  driver.start();
+  const auto frames = collect(ring, 3, 20s);
+  driver.stop();
+  ASSERT_EQ(frames.size(), 3u) << driver.last_error();
+  JpegDecoder jpeg;
+  const cv::Mat bgr = to_mat(frames.back(), jpeg);
+  ASSERT_EQ(bgr.type(), CV_8UC3);
+  ASSERT_EQ(bgr.cols, 640);
+  struct Bar {
+    const char* name;
+    int r, g, b;  // 1: 75 % on, 0: off
+  };
+  constexpr Bar kBars[8] = {{"white", 1, 1, 1}, {"yellow", 1, 1, 0},  {"cyan", 0, 1, 1},
+                            {"green", 0, 1, 0}, {"magenta", 1, 0, 1}, {"red", 1, 0, 0},
+                            {"blue", 0, 0, 1},  {"black", 0, 0, 0}};
+  const int width = bgr.cols / 8;
+  for (int i = 0; i < 8; ++i) {
+    const cv::Rect centre(i * width + width / 4, bgr.rows / 2 - 40, width / 2, 80);
+    const cv::Scalar mean = cv::mean(bgr(centre));
+    std::printf("vivid bar %d (%s): B %.0f G %.0f R %.0f\n", i, kBars[i].name, mean[0], mean[1],
+                mean[2]);
+    const double on = 0.75 * 255.0;
+    EXPECT_NEAR(mean[2], kBars[i].r * on, 30.0) << kBars[i].name << " red";
+    EXPECT_NEAR(mean[1], kBars[i].g * on, 30.0) << kBars[i].name << " green";
+    EXPECT_NEAR(mean[0], kBars[i].b * on, 30.0) << kBars[i].name << " blue";
+  }
+}
+
 TEST_F(VividTest, NegotiatesGrey) {
   SpscRing<ImageFrame> ring(8, common::OverflowPolicy::kDropOldest);
   CameraDriver driver(config(PixelFormat::kGrey), ring);

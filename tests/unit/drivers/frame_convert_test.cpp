@@ -4,7 +4,11 @@
 #include <linux/videodev2.h>
 #include <turbojpeg.h>
 
+#include <array>
+#include <cmath>
+#include <cstring>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "semap/drivers/jpeg_decoder.hpp"
 
@@ -103,6 +107,107 @@ TEST(FrameConvert, MjpegDecodesWithTurbojpegAndRejectsGarbage) {
   EXPECT_FALSE(jpeg.header(garbage));
   f.data = garbage;
   EXPECT_TRUE(to_mat(f, jpeg).empty());
+}
+
+// Saturated patches: a U/V or R/B swap moves at least one channel of each by >= 150 levels.
+struct Rgb {
+  int r, g, b;
+  const char* name;
+};
+constexpr std::array<Rgb, 6> kSaturated = {{{255, 0, 0, "red"},
+                                            {0, 255, 0, "green"},
+                                            {0, 0, 255, "blue"},
+                                            {255, 255, 0, "yellow"},
+                                            {0, 255, 255, "cyan"},
+                                            {255, 0, 255, "magenta"}}};
+
+// BT.601 R'G'B' -> Y'CbCr, limited ("studio") range as a UVC/V4L2 camera sends YUYV:
+// E'y = 0.299 R + 0.587 G + 0.114 B; Y = 16 + 219 E'y, Cb = 128 + 224 (B - E'y) / 1.772,
+// Cr = 128 + 224 (R - E'y) / 1.402 (R, G, B, E'y in 0..1).
+std::array<std::uint8_t, 3> bt601_ycbcr(const Rgb& c) {
+  const double r = c.r / 255.0, g = c.g / 255.0, b = c.b / 255.0;
+  const double ey = 0.299 * r + 0.587 * g + 0.114 * b;
+  const auto q = [](double v) { return static_cast<std::uint8_t>(std::lround(v)); };
+  return {q(16 + 219 * ey), q(128 + 224 * (b - ey) / 1.772), q(128 + 224 * (r - ey) / 1.402)};
+}
+
+void expect_colour(const cv::Vec3b& bgr, const Rgb& c, int tolerance, const std::string& where) {
+  EXPECT_NEAR(bgr[2], c.r, tolerance) << c.name << " red channel " << where;
+  EXPECT_NEAR(bgr[1], c.g, tolerance) << c.name << " green channel " << where;
+  EXPECT_NEAR(bgr[0], c.b, tolerance) << c.name << " blue channel " << where;
+}
+
+TEST(FrameConvert, YuyvSaturatedColoursMatchBt601PerChannel) {
+  // One 8-pixel patch per colour (4 YUYV pairs), 3 rows, 6 bytes of row padding.
+  constexpr std::uint32_t kPatch = 8;
+  auto f = raw_frame(PixelFormat::kYuyv, kPatch * kSaturated.size(), 3, 2, 6);
+  for (std::uint32_t row = 0; row < f.height; ++row) {
+    for (std::size_t i = 0; i < kSaturated.size(); ++i) {
+      const auto [y, cb, cr] = bt601_ycbcr(kSaturated[i]);
+      for (std::uint32_t pair = 0; pair < kPatch / 2; ++pair) {
+        // Y0 U Y1 V (V4L2_PIX_FMT_YUYV)
+        std::uint8_t* p = &f.data[row * f.stride + (i * kPatch + 2 * pair) * 2];
+        p[0] = y;
+        p[1] = cb;
+        p[2] = y;
+        p[3] = cr;
+      }
+    }
+  }
+  JpegDecoder jpeg;
+  const cv::Mat bgr = to_mat(f, jpeg);
+  ASSERT_EQ(bgr.type(), CV_8UC3);
+  ASSERT_EQ(bgr.size(), cv::Size(static_cast<int>(f.width), 3));
+  for (std::size_t i = 0; i < kSaturated.size(); ++i) {
+    for (int row = 0; row < 3; ++row) {
+      for (std::uint32_t x = 0; x < kPatch; ++x) {
+        const int col = static_cast<int>(i * kPatch + x);
+        // Rounding of Y/Cb/Cr to 8 bits and of the 1.164 / 1.596 gains: a few levels.
+        expect_colour(bgr.at<cv::Vec3b>(row, col), kSaturated[i], 6,
+                      "at row " + std::to_string(row) + " col " + std::to_string(col));
+      }
+    }
+  }
+}
+
+TEST(FrameConvert, MjpegSaturatedColoursSurviveEncodeAndDecode) {
+  // 16x16 patches (one 4:2:0 MCU each) in BGR, encoded by libturbojpeg with the chroma
+  // subsamplings cameras use; each patch's centre must keep its colour channel by channel.
+  constexpr int kPatch = 16;
+  cv::Mat src(kPatch, kPatch * static_cast<int>(kSaturated.size()), CV_8UC3);
+  for (std::size_t i = 0; i < kSaturated.size(); ++i) {
+    const Rgb& c = kSaturated[i];
+    src(cv::Rect(static_cast<int>(i) * kPatch, 0, kPatch, kPatch)).setTo(cv::Scalar(c.b, c.g, c.r));
+  }
+  for (const int sampling : {TJSAMP_422, TJSAMP_420, TJSAMP_444}) {
+    tjhandle enc = tjInitCompress();
+    unsigned char* jpeg_buf = nullptr;
+    unsigned long jpeg_size = 0;
+    ASSERT_EQ(tjCompress2(enc, src.data, src.cols, static_cast<int>(src.step), src.rows, TJPF_BGR,
+                          &jpeg_buf, &jpeg_size, sampling, 95, 0),
+              0);
+    ImageFrame f;
+    f.format = PixelFormat::kMjpeg;
+    f.width = static_cast<std::uint32_t>(src.cols);
+    f.height = static_cast<std::uint32_t>(src.rows);
+    f.data.assign(jpeg_buf, jpeg_buf + jpeg_size);
+    tjFree(jpeg_buf);
+    tjDestroy(enc);
+
+    JpegDecoder jpeg;
+    const cv::Mat bgr = to_mat(f, jpeg);
+    ASSERT_EQ(bgr.type(), CV_8UC3);
+    ASSERT_EQ(bgr.size(), src.size());
+    for (std::size_t i = 0; i < kSaturated.size(); ++i) {
+      // The 8x8 centre of the patch: away from the chroma edges with the neighbours.
+      for (int y = 4; y < 12; ++y) {
+        for (int x = 4; x < 12; ++x) {
+          expect_colour(bgr.at<cv::Vec3b>(y, static_cast<int>(i) * kPatch + x), kSaturated[i], 12,
+                        "sampling " + std::to_string(sampling));
+        }
+      }
+    }
+  }
 }
 
 }  // namespace

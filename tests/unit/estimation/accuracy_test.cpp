@@ -1,6 +1,7 @@
 // The accuracy targets on a simulated 10-minute drive (IMU 100 Hz, GNSS 10 Hz with
 // sigma 1 m), for the InEKF with the quaternion ESKF side by side. The figures are printed so
-// the closing note can quote them; only the InEKF is held to the targets.
+// the closing note can quote them; both filters are user-selectable and held to the targets
+// (the ESKF's 180-degree heading recovery is reported only: it is not designed for it).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -57,7 +58,10 @@ TEST(Accuracy, TenMinuteDrive) {
   EXPECT_LE(inekf.heading, 1.0);
   EXPECT_GE(inekf.nees.average, inekf.nees.lower_bound);
   EXPECT_LE(inekf.nees.average, inekf.nees.upper_bound);
-  EXPECT_GT(eskf.ate, 0.0);  // reported, not held to the targets
+  EXPECT_LE(eskf.ate, 0.5);
+  EXPECT_LE(eskf.heading, 1.0);
+  EXPECT_GE(eskf.nees.average, eskf.nees.lower_bound);
+  EXPECT_LE(eskf.nees.average, eskf.nees.upper_bound);
 }
 
 double settle_from_180(FilterKind kind, std::uint64_t seed) {

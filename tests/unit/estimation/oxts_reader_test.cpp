@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "semap/estimation/evaluation.hpp"
@@ -141,6 +142,37 @@ TEST(OxtsParser, RejectsMalformedLinesWithField) {
   const auto t = parse_kitti_timestamp("1970-01-01 00:00:01.5");
   ASSERT_TRUE(t.has_value());
   EXPECT_EQ(t->ns, 1'500'000'000);
+}
+
+// Found by the OXTS fuzz target under UBSan: seconds * 1e9 overflowed int64 for year 7182.
+TEST(OxtsParser, TimestampOutOfRangeNamesTheField) {
+  std::string error;
+  EXPECT_FALSE(parse_kitti_timestamp("7182-01-01 00:00:00", error).has_value());
+  EXPECT_NE(error.find("year 7182"), std::string::npos) << error;
+  EXPECT_FALSE(parse_kitti_timestamp("9999-12-31 23:59:59.999999999", error).has_value());
+  EXPECT_NE(error.find("year"), std::string::npos) << error;
+  EXPECT_FALSE(parse_kitti_timestamp("1969-12-31 23:59:59", error).has_value());
+  EXPECT_NE(error.find("year 1969"), std::string::npos) << error;
+  EXPECT_FALSE(parse_kitti_timestamp("2011-09-26 24:00:00", error).has_value());
+  EXPECT_NE(error.find("hour 24"), std::string::npos) << error;
+  EXPECT_FALSE(parse_kitti_timestamp("2011-09-26 13:-1:25", error).has_value());
+  EXPECT_NE(error.find("minute"), std::string::npos) << error;
+  EXPECT_FALSE(parse_kitti_timestamp("2011-02-30 13:02:25", error).has_value());
+  EXPECT_NE(error.find("day 30"), std::string::npos) << error;
+  // The int64 nanosecond clock ends at 2262-04-11 23:47:16.854775807 UTC.
+  EXPECT_FALSE(parse_kitti_timestamp("2262-12-31 00:00:00", error).has_value());
+  EXPECT_NE(error.find("2262"), std::string::npos) << error;
+  const auto last = parse_kitti_timestamp("2262-04-11 23:47:16.854775807", error);
+  ASSERT_TRUE(last.has_value()) << error;
+  EXPECT_EQ(last->ns, std::numeric_limits<std::int64_t>::max());
+  EXPECT_FALSE(parse_kitti_timestamp("2262-04-11 23:47:16.854775808", error).has_value());
+  // 2000 is a leap year, 1900-style centuries are not (2100).
+  EXPECT_TRUE(parse_kitti_timestamp("2000-02-29 00:00:00", error).has_value()) << error;
+  EXPECT_FALSE(parse_kitti_timestamp("2100-02-29 00:00:00", error).has_value());
+  // 2011-09-26 13:02:25 UTC = 15243 days and 46945 s after the epoch.
+  const auto kitti = parse_kitti_timestamp("2011-09-26 13:02:25.964389445", error);
+  ASSERT_TRUE(kitti.has_value()) << error;
+  EXPECT_EQ(kitti->ns, (15243LL * 86400 + 46945) * 1'000'000'000LL + 964389445);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -13,6 +14,22 @@ namespace semap::mapping {
 namespace {
 
 using ::testing::HasSubstr;
+
+// Bytes before the first block record of a one-layer file: the header (its parameter names
+// read from the file) and the 24-byte layer record.
+std::size_t header_and_layer_size(const std::vector<std::uint8_t>& bytes) {
+  std::size_t at = 8 + 4 + 1 + 1 + 2 + 4 + 8 + 8;  // magic .. prior
+  std::uint32_t parameters = 0;
+  std::memcpy(&parameters, &bytes[at], 4);
+  at += 4;
+  for (std::uint32_t i = 0; i < parameters; ++i) {
+    std::uint16_t length = 0;
+    std::memcpy(&length, &bytes[at], 2);
+    at += 2 + length + 8;
+  }
+  at += 4 + 4;                    // layer count, CRC32
+  return at + 4 + 4 + 8 + 4 + 4;  // "LAYR", source, updates, block count, CRC32
+}
 
 class SmapIo : public ::testing::Test {
  protected:
@@ -113,6 +130,51 @@ TEST_F(SmapIo, SalvageLoadsBlocksBeforeTheDamage) {
   auto bad_header = bytes;
   bad_header[20] ^= 1;
   EXPECT_THROW(decode_smap(bad_header, "h.smap", {.salvage = true}), SmapError);
+}
+
+// A map cut inside its only layer: salvage returns every complete block before the cut. The
+// block count never falls as the cut moves later and reaches the full count.
+TEST_F(SmapIo, SalvageOfCutSingleLayerKeepsEveryBlockBeforeTheCut) {
+  LayeredMap map(testing::small_logodds_params());
+  map.set_layer(1, *testing::random_logodds_map(11).find_layer(1));
+  const auto bytes = encode_smap(map);
+  const std::size_t total = map.resident_blocks();
+  ASSERT_GT(total, 20u);
+  // Where the blocks end: header, layer record and `total` records of equal size before the
+  // 12-byte footer ("SEND", total, CRC32). Computed from the layout in docs/map-files.md.
+  const std::size_t footer = bytes.size() - 12;
+  const std::size_t block_record = (footer - header_and_layer_size(bytes)) / total;
+  ASSERT_EQ(header_and_layer_size(bytes) + total * block_record, footer);
+  const std::size_t first_block = header_and_layer_size(bytes);
+  std::size_t previous = 0;
+  std::size_t cuts = 0;
+  // Cuts all through the blocks, then at every byte of the last block and the footer.
+  std::vector<std::size_t> sizes;
+  for (std::size_t size = first_block; size < footer - block_record; size += block_record / 7 + 1) {
+    sizes.push_back(size);
+  }
+  for (std::size_t size = footer - block_record; size < bytes.size(); ++size) sizes.push_back(size);
+  for (const std::size_t size : sizes) {
+    const SmapReadResult salvaged =
+        decode_smap(std::span(bytes).first(size), "cut.smap", {.salvage = true});
+    ASSERT_FALSE(salvaged.complete) << size;
+    const std::size_t whole = std::min(total, (size - first_block) / block_record);
+    EXPECT_EQ(salvaged.blocks, whole) << "cut at " << size << " of " << bytes.size();
+    EXPECT_GE(salvaged.blocks, previous) << "cut at " << size;
+    EXPECT_THAT(salvaged.problem, HasSubstr("cut.smap: byte offset"));
+    EXPECT_EQ(salvaged.map.resident_blocks(), salvaged.blocks);
+    previous = salvaged.blocks;
+    ++cuts;
+  }
+  EXPECT_GT(cuts, 100u);
+  EXPECT_EQ(previous, total);  // a cut in the footer loses no block
+  // Still refused without salvage, naming the layer.
+  try {
+    decode_smap(std::span(bytes).first(bytes.size() / 2), "cut.smap");
+    FAIL();
+  } catch (const SmapError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("layer 0"));
+  }
 }
 
 TEST_F(SmapIo, RejectsOtherFilesAndVersions) {

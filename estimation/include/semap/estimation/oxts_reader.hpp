@@ -36,7 +36,12 @@ inline constexpr int kOxtsFields = 30;
 // sets `error` to the field at fault.
 std::optional<OxtsRecord> parse_oxts_line(std::string_view line, std::string& error);
 
-// "2011-09-26 13:02:25.964389445" (UTC) to nanoseconds since the epoch.
+// "2011-09-26 13:02:25.964389445" (UTC) to nanoseconds since the epoch. Years outside
+// kMinKittiYear..kMaxKittiYear are refused (nanoseconds since 1970 end in 2262 in an int64).
+// On failure returns nothing and sets `error` to the field at fault ("year 7182 outside ...").
+inline constexpr int kMinKittiYear = 1970;
+inline constexpr int kMaxKittiYear = 2262;
+std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text, std::string& error);
 std::optional<common::Stamp> parse_kitti_timestamp(std::string_view text);
 
 struct OxtsData {

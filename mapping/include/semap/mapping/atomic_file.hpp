@@ -1,5 +1,7 @@
 #pragma once
 
+#include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -11,8 +13,18 @@ namespace semap::mapping {
 // `path`, and the directory is fsynced so the rename itself is durable.
 // With `durable` false the fsyncs are skipped: still atomic against a crashing process, not
 // against power loss (for scratch data such as tiles of a map that is saved properly later).
-// Throws std::runtime_error naming the path and the failing step.
+// Throws std::runtime_error naming the path and the failing step; on any failure the temporary
+// is removed and `path` is untouched. A writer that is killed (SIGKILL, power cut) cannot remove
+// its temporary: `.NAME.XXXXXX` stays next to the target until remove_stale_temporaries.
+// The temporary is flock()ed while it is written.
 void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes,
                            bool durable = true);
+
+// Removes the temporaries write_file_atomically left for `path` when its writer died: names
+// `.NAME.XXXXXX` in the same directory that no process holds locked and that were last written
+// at least `min_age` ago (a writer between mkstemp and flock, or between close and rename, is
+// young). Returns how many were removed; errors are ignored (best effort).
+std::size_t remove_stale_temporaries(const std::filesystem::path& path,
+                                     std::chrono::seconds min_age = std::chrono::seconds(10));
 
 }  // namespace semap::mapping
