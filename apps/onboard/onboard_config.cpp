@@ -139,9 +139,6 @@ void read_depth(const ConfigSection& s, const CameraConfig& camera, DepthConfig&
         s.get_in_range("sync_tolerance_ms", 1e3 * depth.sync_tolerance_s, 0.0, 1000.0) / 1e3;
   } else {
     depth.stereo_calibration = std::filesystem::absolute(s.get<std::string>("calibration"));
-    if (!std::filesystem::is_regular_file(depth.stereo_calibration)) {
-      s.reject("calibration", depth.stereo_calibration.string() + ": no such file");
-    }
     depth.stereo.num_disparities =
         static_cast<int>(s.get_in_range("num_disparities", depth.stereo.num_disparities, 16, 512));
     if (depth.stereo.num_disparities % 16 != 0) {
@@ -169,9 +166,6 @@ void read_segmenter(const ConfigSection& s, SegmenterConfig& seg) {
                  : SegmenterConfig::Kind::kPalette;
   if (seg.kind == SegmenterConfig::Kind::kOnnx) {
     seg.model_card = std::filesystem::absolute(s.get<std::string>("model_card"));
-    if (!std::filesystem::is_regular_file(seg.model_card)) {
-      s.reject("model_card", seg.model_card.string() + ": no such file");
-    }
   } else {
     if (s.has("palette")) seg.palette = std::filesystem::absolute(s.get<std::string>("palette"));
     seg.confidence = static_cast<float>(s.get_in_range("confidence", seg.confidence, 0.01, 1.0));
