@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -108,6 +109,12 @@ int grab(const GrabOptions& o) {
   sd::V4l2Device dev(o.device);
   const sd::V4l2Format format = dev.set_format(fourcc_of(o.format), width, height);
   const double negotiated = dev.set_frame_rate(o.fps);
+  // The device picks the nearest interval it offers: say so when that is not what was asked.
+  const bool fallback = std::abs(negotiated - o.fps) > 0.01 * o.fps;
+  if (fallback) {
+    std::fprintf(stderr, "%s: asked for %.3f fps at %ux%u, the device runs %.3f fps\n",
+                 o.device.c_str(), o.fps, format.width, format.height, negotiated);
+  }
   const auto pixel_format = sd::from_fourcc(format.fourcc);
   if (!o.out.empty() && !pixel_format) {
     throw sd::DriverError(
@@ -159,12 +166,14 @@ int grab(const GrabOptions& o) {
   if (o.json) {
     std::printf(
         "{\"device\":\"%s\",\"card\":\"%s\",\"driver\":\"%s\",\"format\":\"%s\",\"width\":%u,"
-        "\"height\":%u,\"negotiated_fps\":%.3f,\"frames\":%zu,\"fps\":%.3f,"
+        "\"height\":%u,\"requested_fps\":%.3f,\"negotiated_fps\":%.3f,\"rate_fallback\":%s,"
+        "\"frames\":%zu,\"fps\":%.3f,"
         "\"mean_interval_ms\":%.3f,\"jitter_ms\":%.3f,\"max_deviation_ms\":%.3f,\"skipped\":%llu,"
         "\"flagged\":%d,\"png_written\":%d}\n",
         o.device.c_str(), dev.card().c_str(), dev.driver().c_str(), fourcc.c_str(), format.width,
-        format.height, negotiated, t.frames, t.fps, t.mean_interval_ms, t.jitter_ms,
-        t.max_deviation_ms, static_cast<unsigned long long>(t.skipped), flagged, written);
+        format.height, o.fps, negotiated, fallback ? "true" : "false", t.frames, t.fps,
+        t.mean_interval_ms, t.jitter_ms, t.max_deviation_ms,
+        static_cast<unsigned long long>(t.skipped), flagged, written);
   } else {
     std::printf("%s: %s (%s), %s %ux%u, negotiated %.3f fps\n", o.device.c_str(),
                 dev.card().c_str(), dev.driver().c_str(), fourcc.c_str(), format.width,

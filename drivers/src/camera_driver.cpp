@@ -40,10 +40,15 @@ void CameraDriver::open_device() {
   CameraNegotiation n;
   n.format = device->set_format(wanted, config_.width, config_.height);
   n.fps = device->set_frame_rate(config_.fps);
+  n.requested_fps = config_.fps;
   n.card = device->card();
   device->start(config_.buffers);
   log().info("{} ({}): {} {}x{} @ {:.2f} fps", config_.device, n.card,
              fourcc_to_string(n.format.fourcc), n.format.width, n.format.height, n.fps);
+  if (n.rate_fallback()) {
+    log().warn("{}: asked for {:.2f} fps at {}x{}, the device runs {:.2f} fps", config_.device,
+               n.requested_fps, n.format.width, n.format.height, n.fps);
+  }
   {
     std::lock_guard lock(negotiation_mutex_);
     negotiation_ = n;

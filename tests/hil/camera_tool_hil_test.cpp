@@ -4,6 +4,7 @@
 #include <linux/videodev2.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -97,6 +98,14 @@ TEST_F(CameraToolHil, GrabsFramesAsPngAndMeasuresTheRate) {
   EXPECT_EQ(json_number(out, "height"), 480);
   const double negotiated = json_number(out, "negotiated_fps");
   ASSERT_GT(negotiated, 0) << out;
+  // 30 fps is honoured, or the rate the device runs instead is reported (JSON and stderr).
+  EXPECT_EQ(json_number(out, "requested_fps"), 30) << out;
+  const bool fallback = out.find("\"rate_fallback\":true") != std::string::npos;
+  EXPECT_EQ(fallback, std::abs(negotiated - 30.0) > 0.3) << out;
+  if (fallback) {
+    EXPECT_NE(out.find("asked for 30.000 fps at 640x480, the device runs"), std::string::npos)
+        << out;
+  }
   // vivid paces frames by the negotiated interval (a loaded VM may run a little behind).
   EXPECT_NEAR(json_number(out, "fps"), negotiated, 0.2 * negotiated) << out;
   EXPECT_GE(json_number(out, "jitter_ms"), 0) << out;

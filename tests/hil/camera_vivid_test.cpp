@@ -88,6 +88,8 @@ TEST_F(VividTest, Captures300YuyvFramesAtConfiguredRate) {
   EXPECT_EQ(n.format.width, 640u);
   EXPECT_EQ(n.format.height, 480u);
   ASSERT_GT(n.fps, 0.0);
+  // What was asked is kept next to what the device runs (a fallback is logged at open).
+  EXPECT_DOUBLE_EQ(n.requested_fps, 30.0);
   // vivid derives its sequence from elapsed time; under TCG a late tick can repeat one, so
   // sequences only need to be non-decreasing. Timestamps must strictly increase.
   int repeated_sequences = 0;

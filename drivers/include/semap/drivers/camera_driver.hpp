@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -32,8 +33,12 @@ struct CameraConfig {
 // What the device agreed to; valid once state() is kRunning.
 struct CameraNegotiation {
   V4l2Format format;
-  double fps = 0.0;
+  double fps = 0.0;            // the rate the device runs at
+  double requested_fps = 0.0;  // camera.fps
   std::string card;
+  // The device would not run at the requested rate (it offers other intervals): logged as a
+  // warning when the camera opens.
+  bool rate_fallback() const { return std::abs(fps - requested_fps) > 0.01 * requested_fps; }
 };
 
 // V4L2 capture thread: negotiates format/size/rate, streams mmap buffers, copies each frame
