@@ -89,6 +89,10 @@ function(semap_executable name)
   add_executable(${name} ${ARG_SOURCES})
   target_compile_options(${name} PRIVATE ${SEMAP_WARNINGS})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS})
+  # The user-facing tools (semap-*) are installed; bench helpers stay in the build tree.
+  if(name MATCHES "^semap-")
+    install(TARGETS ${name} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  endif()
 endfunction()
 
 # semap_test(NAME SOURCES ... LIBS ... [LABELS ...] [TIMEOUT s] [ENV ...])

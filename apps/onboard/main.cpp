@@ -31,6 +31,7 @@
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/drivers/gnss_driver.hpp"
 #include "semap/mapping/smap_io.hpp"
+#include "service_notifier.hpp"
 #include "shared_pose_history.hpp"
 #include "sim_report.hpp"
 #include "sim_rig.hpp"
@@ -327,6 +328,9 @@ int run(const semap::onboard::OnboardConfig& config, const RunOptions& options) 
   log->info("running{}{}", rig ? " on the simulated rig (GNSS via " + rig->gnss_device() + ")" : "",
             replay ? " on a replay of " + config.rig.replay.string() : "");
 
+  const onboard::ServiceNotifier service;
+  service.ready();
+  if (service.watchdog_enabled()) log->info("systemd watchdog: pinging every second");
   LiveAccuracy accuracy;
   const auto started = common::Stamp::now();
   auto next_report = started + 5.0;
@@ -346,8 +350,13 @@ int run(const semap::onboard::OnboardConfig& config, const RunOptions& options) 
     if (rig) accuracy.sample(*rig, est);
     if (report) report->sample_pose(est);
     const auto now = common::Stamp::now();
-    if (dds && now >= next_health) {
+    // Once a second: the systemd watchdog (this loop is alive) and the health report.
+    const bool health_due = now >= next_health;
+    if (health_due) {
       next_health = now + 1.0;
+      service.watchdog();
+    }
+    if (dds && health_due) {
       std::vector<dds_idl::DriverCountersData> driver_counters;
       if (gnss_driver)
         driver_counters.push_back(onboard::driver_health("gnss", gnss_driver->stats()));
@@ -379,6 +388,7 @@ int run(const semap::onboard::OnboardConfig& config, const RunOptions& options) 
     }
   }
 
+  service.stopping();
   if (rig) rig->stop();
   if (replay) replay->stop();
   if (imu_driver) imu_driver->stop();
