@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "drive_fixtures.hpp"
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/so3.hpp"
 
@@ -12,29 +13,9 @@ namespace semap::estimation {
 namespace {
 
 using Eigen::Vector3d;
-
-SimulatorConfig drive(double seconds, std::uint64_t seed = 11) {
-  SimulatorConfig c;
-  c.duration_s = seconds;
-  c.seed = seed;
-  return c;
-}
-
-EstimatorConfig eskf(const SimulationData& data) {
-  EstimatorConfig c;
-  c.filter = FilterKind::kQuaternionEskf;
-  c.init.yaw_rad = yaw_of(data.truth.front().state.rotation);
-  c.init.yaw_sigma_rad = 0.05;
-  return c;
-}
-
-double max_position_error_after(const EvaluationRun& run, double t0) {
-  double worst = 0.0;
-  for (const auto& s : run.samples) {
-    if (s.t >= t0) worst = std::max(worst, (s.estimate.position - s.truth.position).norm());
-  }
-  return worst;
-}
+using test::drive;
+using test::heading_known;
+using test::max_position_error_after;
 
 // GNSS sigma 1 m per axis (1.7 m 3-D): the fused estimate must be well inside that.
 TEST(Eskf, TwoMinuteDriveAccuracy) {
@@ -43,7 +24,8 @@ TEST(Eskf, TwoMinuteDriveAccuracy) {
     EvaluationOptions options;
     options.metrics_after_s = 30.0;
     options.motion_start_s = 2.0;
-    const EvaluationRun run = run_evaluation(data, eskf(data), options);
+    const EvaluationRun run =
+        run_evaluation(data, heading_known(data, FilterKind::kQuaternionEskf), options);
     std::printf("ESKF 2-min drive, seed %lu: ATE %.3f m, heading RMSE %.3f deg\n",
                 static_cast<unsigned long>(seed), run.metrics.ate_rmse_m,
                 run.metrics.heading_rmse_deg);
@@ -56,7 +38,8 @@ TEST(Eskf, TwoMinuteDriveAccuracy) {
 // Normal fixes are accepted: at a 0.999 gate a clean drive loses at most a handful.
 TEST(Eskf, AcceptsNormalFixes) {
   const SimulationData data = simulate(drive(90.0));
-  const EvaluationRun run = run_evaluation(data, eskf(data), {});
+  const EvaluationRun run =
+      run_evaluation(data, heading_known(data, FilterKind::kQuaternionEskf), {});
   EXPECT_LE(run.counters.gnss_rejected, 3u);
   EXPECT_GE(run.counters.gnss_applied + run.counters.gnss_rejected + 30, data.gnss.size());
   EXPECT_EQ(run.counters.reanchors, 0u);
@@ -67,7 +50,8 @@ TEST(Eskf, GatesATransientFiftyMetreJump) {
   SimulatorConfig sc = drive(90.0);
   sc.jumps.push_back({60.0, 0.5, Vector3d(50.0, 0.0, 0.0)});
   const SimulationData data = simulate(sc);
-  const EvaluationRun run = run_evaluation(data, eskf(data), {});
+  const EvaluationRun run =
+      run_evaluation(data, heading_known(data, FilterKind::kQuaternionEskf), {});
   EXPECT_EQ(run.counters.gnss_rejected, 5u);
   EXPECT_EQ(run.counters.reanchors, 0u);
   EXPECT_LT(max_position_error_after(run, 30.0), 3.0);
@@ -79,9 +63,11 @@ TEST(Eskf, GatesASingleOutlierFix) {
   SimulatorConfig sc = drive(90.0);
   sc.jumps.push_back({45.0, 0.05, Vector3d(0.0, 8.0, 0.0)});
   const SimulationData data = simulate(sc);
-  const EvaluationRun with = run_evaluation(data, eskf(data), {});
+  const EvaluationRun with =
+      run_evaluation(data, heading_known(data, FilterKind::kQuaternionEskf), {});
   const SimulationData clean_data = simulate(drive(90.0));
-  const EvaluationRun clean = run_evaluation(clean_data, eskf(clean_data), {});
+  const EvaluationRun clean =
+      run_evaluation(clean_data, heading_known(clean_data, FilterKind::kQuaternionEskf), {});
   EXPECT_EQ(with.counters.gnss_rejected, clean.counters.gnss_rejected + 1);
   EXPECT_LT(max_position_error_after(with, 30.0), 2.0);
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "drive_fixtures.hpp"
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/gnss_reorder_buffer.hpp"
 #include "semap/estimation/simulator.hpp"
@@ -15,6 +16,9 @@ namespace {
 
 using common::Stamp;
 using Eigen::Vector3d;
+using test::drive;
+using test::heading_known;
+using test::max_position_error_after;
 
 common::ImuSample imu_at(double t, const Vector3d& gyro = Vector3d::Zero(),
                          const Vector3d& accel = Vector3d(0, 0, 9.80665)) {
@@ -123,43 +127,21 @@ TEST(Estimator, BadInputIsCountedNotFatal) {
   EXPECT_FALSE(e.anchor().has_value());
 }
 
-SimulatorConfig short_drive(double seconds) {
-  SimulatorConfig c;
-  c.duration_s = seconds;
-  c.seed = 11;
-  return c;
-}
-
-EstimatorConfig good_heading(const SimulationData& data) {
-  EstimatorConfig c;
-  c.init.yaw_rad = yaw_of(data.truth.front().state.rotation);
-  c.init.yaw_sigma_rad = 0.05;
-  return c;
-}
-
-double max_position_error_after(const EvaluationRun& run, double t0) {
-  double worst = 0.0;
-  for (const auto& s : run.samples) {
-    if (s.t >= t0) worst = std::max(worst, (s.estimate.position - s.truth.position).norm());
-  }
-  return worst;
-}
-
 TEST(Estimator, GatesATransientFiftyMetreJump) {
-  SimulatorConfig sc = short_drive(90.0);
+  SimulatorConfig sc = drive(90.0);
   sc.jumps.push_back({60.0, 0.5, Vector3d(50.0, 0.0, 0.0)});
   const SimulationData data = simulate(sc);
-  const EvaluationRun run = run_evaluation(data, good_heading(data), {});
+  const EvaluationRun run = run_evaluation(data, heading_known(data), {});
   EXPECT_EQ(run.counters.gnss_rejected, 5u);  // the five jumped fixes, nothing else
   EXPECT_EQ(run.counters.reanchors, 0u);
   EXPECT_LT(max_position_error_after(run, 30.0), 3.0);
 }
 
 TEST(Estimator, RecoversFromPersistentJumpByReanchoring) {
-  SimulatorConfig sc = short_drive(120.0);
+  SimulatorConfig sc = drive(120.0);
   sc.jumps.push_back({60.0, 1000.0, Vector3d(50.0, -20.0, 0.0)});
   const SimulationData data = simulate(sc);
-  const EvaluationRun run = run_evaluation(data, good_heading(data), {});
+  const EvaluationRun run = run_evaluation(data, heading_known(data), {});
   EXPECT_EQ(run.counters.reanchors, 1u);
   EXPECT_GE(run.counters.gnss_rejected, 10u);
   EXPECT_LE(run.counters.gnss_rejected, 12u);
@@ -169,8 +151,8 @@ TEST(Estimator, RecoversFromPersistentJumpByReanchoring) {
 }
 
 TEST(Estimator, LateFixesAreAppliedInOrderWithinTheImuDelay) {
-  const SimulationData data = simulate(short_drive(40.0));
-  EstimatorConfig config = good_heading(data);
+  const SimulationData data = simulate(drive(40.0));
+  EstimatorConfig config = heading_known(data);
   config.anchor = data.origin;
   config.imu_delay_s = 0.2;  // swapped pairs arrive up to 0.15 s late
   Estimator e(config);
@@ -209,8 +191,8 @@ TEST(Estimator, LateFixesAreAppliedInOrderWithinTheImuDelay) {
 // that hand over their fixes before the IMU samples they fall between (as the onboard stage
 // does) give exactly the estimate of a feed in stamp order, from initialisation on.
 TEST(Estimator, FixesAheadOfTheImuGiveTheEstimateOfAStampOrderedFeed) {
-  const SimulationData data = simulate(short_drive(40.0));
-  EstimatorConfig config = good_heading(data);
+  const SimulationData data = simulate(drive(40.0));
+  EstimatorConfig config = heading_known(data);
   config.anchor = data.origin;
   Estimator ordered(config);
   Estimator batched(config);
@@ -250,7 +232,7 @@ TEST(Estimator, EstimatesStaticBiases) {
   sc.gnss_velocity = true;
   sc.seed = 5;
   const SimulationData data = simulate(sc);
-  EstimatorConfig config = good_heading(data);
+  EstimatorConfig config = heading_known(data);
   config.use_gnss_velocity = true;  // at rest, position-only GNSS lets tilt and yaw wander
   config.anchor = data.origin;
   Estimator e(config);
@@ -280,8 +262,8 @@ TEST(Estimator, EstimatesStaticBiases) {
 }
 
 TEST(Estimator, InterpolatesPoseFromHistory) {
-  const SimulationData data = simulate(short_drive(20.0));
-  EstimatorConfig config = good_heading(data);
+  const SimulationData data = simulate(drive(20.0));
+  EstimatorConfig config = heading_known(data);
   config.anchor = data.origin;
   Estimator e(config);
   std::size_t g = 0;
