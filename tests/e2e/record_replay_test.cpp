@@ -165,6 +165,17 @@ TEST_F(RecordReplay, TheRecordingHoldsEveryStream) {
   }
   EXPECT_EQ(candump.error(), "");
   EXPECT_EQ(frames, figure(out, "recording        : " + rec().string() + ": "));
+  // can-utils reads it as its own: log2asc converts every line.
+  if (fs::exists("/usr/bin/log2asc")) {
+    const auto asc = run_cli("/usr/bin/log2asc", "-I " + (rec() / "imu.log").string() + " sim");
+    ASSERT_EQ(asc.status, 0) << asc.out.substr(0, 500);
+    long long rx = 0;
+    for (std::size_t at = asc.out.find(" Rx "); at != std::string::npos;
+         at = asc.out.find(" Rx ", at + 1)) {
+      ++rx;
+    }
+    EXPECT_EQ(rx, frames);
+  }
   // 3 frames per sample of the semap profile.
   EXPECT_EQ(frames, 3 * figure(out, "estimation       : ")) << out;
 
