@@ -94,9 +94,7 @@ int main(int argc, char** argv) {
     base.init.yaw_rad = est::yaw_of(data.truth.front().state.rotation) +
                         heading_error_deg * std::numbers::pi / 180.0;
 
-    std::vector<std::pair<std::string, est::FilterKind>> kinds;
-    if (filter != "eskf") kinds.emplace_back("InEKF", est::FilterKind::kLeftInekf);
-    if (filter != "inekf") kinds.emplace_back("ESKF", est::FilterKind::kQuaternionEskf);
+    const auto kinds = est::filters_to_evaluate(filter);
     std::vector<est::EvaluationRun> runs;
     for (const auto& [name, kind] : kinds) {
       est::EstimatorConfig config = base;

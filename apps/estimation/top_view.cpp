@@ -21,7 +21,7 @@ const std::array<cv::Scalar, 3> kColours = {cv::Scalar(200, 80, 0), cv::Scalar(0
 }  // namespace
 
 void write_top_view(const std::filesystem::path& path, const estimation::SimulationData& data,
-                    const std::vector<LabelledRun>& runs) {
+                    const std::vector<LabelledRun>& runs, const std::string& truth_label) {
   const estimation::LocalEnu enu(data.origin);
   std::vector<Eigen::Vector3d> fixes;
   for (const auto& f : data.gnss) {
@@ -50,7 +50,7 @@ void write_top_view(const std::filesystem::path& path, const estimation::Simulat
   for (const auto& t : data.truth) line.push_back(pixel(t.state.position));
   cv::polylines(image, line, false, cv::Scalar(0, 150, 0), 2, cv::LINE_AA);
   int legend_y = 25;
-  cv::putText(image, "truth", {10, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 150, 0}, 2);
+  cv::putText(image, truth_label, {10, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 150, 0}, 2);
   for (std::size_t i = 0; i < runs.size(); ++i) {
     line.clear();
     for (const auto& s : runs[i].run->samples) line.push_back(pixel(s.estimate.position));

@@ -68,6 +68,7 @@ mapping::MapParams kitti_raw_params() {
 struct ScanStats {
   std::size_t mapped = 0;
   std::size_t without_pose = 0;  // scan stamp outside the filter's trajectory
+  std::size_t soft = 0;          // scans inserted with the segmenter's probabilities
   std::uint64_t points = 0;
   std::uint64_t inserted = 0;
   perception::DropCounts drops;
@@ -147,6 +148,7 @@ ScanStats map_scans(const KittiRawDrive& drive, std::size_t first, std::size_t l
     world_from_body.translation() = pose->position.cast<float>();
     common::LabeledCloud cloud = mapping::transform_cloud(body, world_from_body);
     cloud.stamp = drive.scan_stamps[i];
+    stats.soft += cloud.has_probabilities() ? 1 : 0;
     stats.label_seconds.push_back(seconds_since(start));
     start = std::chrono::steady_clock::now();
     map.insert(cloud, cloud.origin);
@@ -239,9 +241,7 @@ int run(const CLI::App& command, const RawOptions& o) {
   base.init.yaw_sigma_rad = o.initial_yaw_sigma_deg * std::numbers::pi / 180.0;
   est::EvaluationOptions eval;
   eval.metrics_after_s = o.metrics_after;
-  std::vector<std::pair<std::string, est::FilterKind>> kinds;
-  if (o.filter != "eskf") kinds.emplace_back("InEKF", est::FilterKind::kLeftInekf);
-  if (o.filter != "inekf") kinds.emplace_back("ESKF", est::FilterKind::kQuaternionEskf);
+  const auto kinds = est::filters_to_evaluate(o.filter);
   std::vector<est::EvaluationRun> runs;
   for (const auto& [name, kind] : kinds) {
     est::EstimatorConfig config = base;
@@ -257,7 +257,7 @@ int run(const CLI::App& command, const RawOptions& o) {
   std::vector<LabelledRun> labelled;
   for (std::size_t i = 0; i < runs.size(); ++i) labelled.push_back({kinds[i].first, &runs[i]});
   write_csv(fs::path(o.out) / "trajectory.csv", labelled);
-  write_top_view(fs::path(o.out) / "top_view.png", data, labelled);
+  write_top_view(fs::path(o.out) / "top_view.png", data, labelled, "OXTS");
 
   if (drive.scans.empty()) throw DriveError(drive_dir.string() + ": no scans");
   const std::size_t last =
@@ -269,8 +269,8 @@ int run(const CLI::App& command, const RawOptions& o) {
   ProgressMeter meter("semap-kitti raw", o.progress_seconds);
   const ScanStats s =
       map_scans(drive, o.first, last, history, *labels, camera, body_from_velo, map, meter);
-  std::printf("scans %zu mapped %zu without_pose %zu (posed by %s, no deskew)\n",
-              last - o.first + 1, s.mapped, s.without_pose, kinds.front().first.c_str());
+  std::printf("scans %zu mapped %zu without_pose %zu soft_labelled %zu (posed by %s, no deskew)\n",
+              last - o.first + 1, s.mapped, s.without_pose, s.soft, kinds.front().first.c_str());
   std::printf("points %llu inserted %llu out_of_image %llu out_of_range %llu no_label %llu "
               "no_depth %llu\n",
               static_cast<unsigned long long>(s.points), static_cast<unsigned long long>(s.inserted),

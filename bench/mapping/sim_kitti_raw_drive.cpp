@@ -11,6 +11,7 @@
 #include "semap/estimation/oxts_writer.hpp"
 #include "semap/map_io/semantic_kitti_io.hpp"
 #include "semap/perception/lidar_projection.hpp"
+#include "semap/perception/sim_camera.hpp"
 #include "semap/perception/sim_classes.hpp"
 
 namespace semap::bench {
@@ -85,6 +86,24 @@ cv::Mat render_labels(const perception::SimWorld& world, const Eigen::Isometry3f
   return labels;
 }
 
+// The simulated colour camera with image_02's pinhole (P_rect_02's left 3x3; no skew).
+perception::SimCamera kitti_colour_camera(const perception::KittiCameraCalibration& calib,
+                                          std::uint64_t seed) {
+  perception::SimCameraOptions options;
+  options.intrinsics.width = calib.image_size.width;
+  options.intrinsics.height = calib.image_size.height;
+  options.intrinsics.fx = static_cast<float>(calib.p_rect(0, 0));
+  options.intrinsics.fy = static_cast<float>(calib.p_rect(1, 1));
+  options.intrinsics.cx = static_cast<float>(calib.p_rect(0, 2));
+  options.intrinsics.cy = static_cast<float>(calib.p_rect(1, 2));
+  options.seed = seed;
+  return perception::SimCamera(options);
+}
+
+void write_png(const fs::path& path, const cv::Mat& image) {
+  if (!cv::imwrite(path.string(), image)) throw std::runtime_error(path.string() + ": cannot write");
+}
+
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path);
   out << text;
@@ -106,7 +125,8 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
   out.calib_dir = root / "2011_09_26";
   out.drive_dir = out.calib_dir / "2011_09_26_drive_0001_sync";
   out.labels_dir = out.drive_dir / "labels_02";
-  for (const char* sub : {"oxts/data", "velodyne_points/data", "labels_02"}) {
+  out.image_dir = out.drive_dir / "image_02" / "data";
+  for (const char* sub : {"oxts/data", "velodyne_points/data", "labels_02", "image_02/data"}) {
     fs::create_directories(out.drive_dir / sub);
   }
   for (const char* name : {"calib_cam_to_cam.txt", "calib_velo_to_cam.txt", "calib_imu_to_velo.txt"}) {
@@ -120,6 +140,10 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
           .inverse();
   const Eigen::Isometry3d velo_from_rect =
       camera.cam_from_lidar.inverse() * Eigen::Isometry3d(camera.r_rect.transpose());
+  // Camera 2's centre in the rectified frame of camera 0: -M^-1 p4 of P_rect_02 = [M | p4].
+  const Eigen::Vector3d cam2_centre =
+      -camera.p_rect.leftCols<3>().inverse() * camera.p_rect.col(3);
+  const perception::SimCamera colour = kitti_colour_camera(camera, o.seed);
 
   estimation::SimulatorConfig sc;
   sc.duration_s = o.duration_s;
@@ -163,11 +187,14 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
     scan_stamps << estimation::format_kitti_timestamp(
                        common::Stamp(truth[at].stamp.ns + kEpochNs))
                 << '\n';
-    const cv::Mat labels = render_labels(
-        world, (street_from_velo * velo_from_rect).cast<float>(), camera, o.label_stride);
-    if (!cv::imwrite((out.labels_dir / frame_name(packet, ".png")).string(), labels)) {
-      throw std::runtime_error((out.labels_dir / frame_name(packet, ".png")).string() +
-                               ": cannot write");
+    const Eigen::Isometry3d street_from_rect = street_from_velo * velo_from_rect;
+    write_png(out.labels_dir / frame_name(packet, ".png"),
+              render_labels(world, street_from_rect.cast<float>(), camera, o.label_stride));
+    if (o.colour_images) {
+      const Eigen::Isometry3d street_from_cam2 =
+          street_from_rect * Eigen::Translation3d(cam2_centre);
+      write_png(out.image_dir / frame_name(packet, ".png"),
+                colour.render(world, street_from_cam2.cast<float>(), packet).bgr);
     }
     ++out.scans;
   }

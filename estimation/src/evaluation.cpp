@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include "semap/estimation/so3.hpp"
 
@@ -54,6 +55,17 @@ EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
   run.metrics = score(run.samples, options);
   run.counters = estimator.counters();
   return run;
+}
+
+std::vector<std::pair<std::string, FilterKind>> filters_to_evaluate(std::string_view choice) {
+  if (choice != "inekf" && choice != "eskf" && choice != "both") {
+    throw std::invalid_argument("filter must be inekf, eskf or both, got '" +
+                                std::string(choice) + "'");
+  }
+  std::vector<std::pair<std::string, FilterKind>> kinds;
+  if (choice != "eskf") kinds.emplace_back("InEKF", FilterKind::kLeftInekf);
+  if (choice != "inekf") kinds.emplace_back("ESKF", FilterKind::kQuaternionEskf);
+  return kinds;
 }
 
 EvaluationMetrics score(const std::vector<EvaluationSample>& samples,

@@ -21,13 +21,17 @@ TEST(OxtsWriter, TimestampRoundTrips) {
   EXPECT_EQ(parse_kitti_timestamp(text)->ns, stamp.ns);
 }
 
+SimulationData simulated_car(double seconds) {
+  SimulatorConfig sc;
+  sc.duration_s = seconds;
+  return simulate(sc);
+}
+
 // The simulator's car through writer, parser and conversion: every IMU sample, truth pose and
 // (noise-free) fix equals the simulator's, so the reader's frames (body x forward, y left,
 // z up; ENU world; yaw from east) and signs are the simulator's.
 TEST(OxtsWriter, ConversionMatchesTheSimulatorsTruth) {
-  SimulatorConfig sc;
-  sc.duration_s = 40.0;
-  const SimulationData sim = simulate(sc);
+  const SimulationData sim = simulated_car(40.0);
   const LocalEnu enu(sim.origin);
   OxtsData data;
   for (std::size_t i = 0; i < sim.imu.size(); i += 7) {
@@ -69,13 +73,11 @@ TEST(OxtsWriter, ConversionMatchesTheSimulatorsTruth) {
 }
 
 TEST(OxtsWriter, PacketAccuracyIsTheFixSigma) {
-  SimulatorConfig sc;
-  sc.duration_s = 10.0;
-  const SimulationData sim = simulate(sc);
-  const LocalEnu enu(sim.origin);
+  const SimulationData sim = simulated_car(10.0);
   OxtsData data;
   for (std::size_t i = 0; i < 3; ++i) {
-    data.records.push_back(oxts_record_from_state(sim.truth[i].state, sim.imu[i], enu,
+    data.records.push_back(oxts_record_from_state(sim.truth[i].state, sim.imu[i],
+                                                  LocalEnu(sim.origin),
                                                   0.5 * static_cast<double>(i)));
   }
   const SimulationData in = oxts_to_inputs(data, 7.0, 1, OxtsGnssNoise::kPacketAccuracy);

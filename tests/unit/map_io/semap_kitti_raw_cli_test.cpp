@@ -131,6 +131,37 @@ TEST_F(SemapKittiRawDrive, ScanRangeAndPacketNoise) {
   EXPECT_FALSE(has(r.out, "ESKF")) << r.out;
 }
 
+// The shipped network (trained on the simulated camera) segments image_02; its probabilities
+// go into the map as soft labels, and the ground below the car comes out as road.
+TEST(SemapKittiRawSegmenter, ModelCardLabelsTheCameraImages) {
+  const fs::path root = temp_dir("segmenter");
+  bench::SimKittiRawOptions o;
+  o.duration_s = 6.0;
+  o.azimuths = 300;
+  o.beams = 32;
+  o.colour_images = true;
+  const auto drive = bench::write_sim_kitti_raw_drive(root, kKittiCalib, o);
+  const fs::path card = fs::path(SEMAP_SOURCE_DIR) / "models/semap-seg.yaml";
+  const CliResult r = run("raw --drive " + drive.drive_dir.string() + " --segmenter " +
+                          card.string() + " --out " + (root / "out").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(has(r.out, "onnx segmenter")) << r.out;
+  EXPECT_EQ(figure(r.out, "soft_labelled "), figure(r.out, "mapped ")) << r.out;
+  const auto cells = occupied_cells(mapping::read_smap(root / "out/map.smap").map);
+  const Eigen::Vector3d under = drive.simulation.truth.back().state.position;
+  std::map<int, int> below;
+  for (const auto& c : cells) {
+    if ((c.centre.head<2>() - under.head<2>()).norm() < 1.5) ++below[c.label];
+  }
+  EXPECT_GT(below[1], below[3] + below[4] + below[5]) << below[1];
+  fs::remove(drive.image_dir / "0000000020.png");
+  const CliResult missing = run("raw --drive " + drive.drive_dir.string() + " --segmenter " +
+                                card.string() + " --out " + (root / "out").string());
+  EXPECT_EQ(missing.status, 2) << missing.out;
+  EXPECT_TRUE(has(missing.out, "image_02/data/0000000020.png: missing image")) << missing.out;
+  fs::remove_all(root);
+}
+
 // A small drive of its own per case, broken in one way.
 class SemapKittiRawBadInput : public ::testing::Test {
  protected:

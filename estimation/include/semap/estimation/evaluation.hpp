@@ -1,5 +1,8 @@
 #pragma once
 
+#include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "semap/estimation/estimator.hpp"
@@ -41,6 +44,10 @@ struct EvaluationRun {
 // the truth. The estimator is anchored at data.origin so truth and estimate share a frame.
 EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
                              const EvaluationOptions& options);
+
+// The filters an evaluation tool runs for its --filter choice ("inekf", "eskf" or "both",
+// InEKF first), with the names the tools print. Throws std::invalid_argument otherwise.
+std::vector<std::pair<std::string, FilterKind>> filters_to_evaluate(std::string_view choice);
 
 // Metrics of already collected samples (t >= options.metrics_after_s).
 EvaluationMetrics score(const std::vector<EvaluationSample>& samples,
