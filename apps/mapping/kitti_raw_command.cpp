@@ -241,36 +241,30 @@ int run(const CLI::App& command, const RawOptions& o) {
   base.init.yaw_sigma_rad = o.initial_yaw_sigma_deg * std::numbers::pi / 180.0;
   est::EvaluationOptions eval;
   eval.metrics_after_s = o.metrics_after;
-  const auto kinds = est::filters_to_evaluate(o.filter);
-  std::vector<est::EvaluationRun> runs;
-  for (const auto& [name, kind] : kinds) {
-    est::EstimatorConfig config = base;
-    config.filter = kind;
-    runs.push_back(est::run_evaluation(data, config, eval));
-    const auto& m = runs.back().metrics;
+  const auto runs = est::run_filters(data, base, eval, o.filter);
+  for (const auto& [name, run] : runs) {
     std::printf("%-5s ATE %.3f m heading_rmse %.3f deg (unaligned, %zu samples after %.0f s)\n",
-                name.c_str(), m.ate_rmse_m, m.heading_rmse_deg, m.samples, o.metrics_after);
+                name.c_str(), run.metrics.ate_rmse_m, run.metrics.heading_rmse_deg,
+                run.metrics.samples, o.metrics_after);
   }
   std::printf("GNSS  ATE %.3f m (the fixes the filters were given)\n", gnss_ate(data));
 
   fs::create_directories(o.out);
-  std::vector<LabelledRun> labelled;
-  for (std::size_t i = 0; i < runs.size(); ++i) labelled.push_back({kinds[i].first, &runs[i]});
-  write_csv(fs::path(o.out) / "trajectory.csv", labelled);
-  write_top_view(fs::path(o.out) / "top_view.png", data, labelled, "OXTS");
+  write_csv(fs::path(o.out) / "trajectory.csv", runs);
+  write_top_view(fs::path(o.out) / "top_view.png", data, runs, "OXTS");
 
   if (drive.scans.empty()) throw DriveError(drive_dir.string() + ": no scans");
   const std::size_t last =
       command.count("--last") > 0 ? std::min(o.last, drive.scans.size() - 1) : drive.scans.size() - 1;
   if (o.first > last) throw DriveError("--first " + std::to_string(o.first) + " beyond the scans");
   // The map follows the first filter run (the InEKF unless --filter eskf).
-  const est::PoseHistory history = history_of(runs.front(), data.imu.front().stamp);
+  const est::PoseHistory history = history_of(runs.front().run, data.imu.front().stamp);
   mapping::SemanticMap map(params);
   ProgressMeter meter("semap-kitti raw", o.progress_seconds);
   const ScanStats s =
       map_scans(drive, o.first, last, history, *labels, camera, body_from_velo, map, meter);
   std::printf("scans %zu mapped %zu without_pose %zu soft_labelled %zu (posed by %s, no deskew)\n",
-              last - o.first + 1, s.mapped, s.without_pose, s.soft, kinds.front().first.c_str());
+              last - o.first + 1, s.mapped, s.without_pose, s.soft, runs.front().name.c_str());
   std::printf("points %llu inserted %llu out_of_image %llu out_of_range %llu no_label %llu "
               "no_depth %llu\n",
               static_cast<unsigned long long>(s.points), static_cast<unsigned long long>(s.inserted),

@@ -57,15 +57,23 @@ EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
   return run;
 }
 
-std::vector<std::pair<std::string, FilterKind>> filters_to_evaluate(std::string_view choice) {
+std::vector<NamedEvaluationRun> run_filters(const SimulationData& data,
+                                            const EstimatorConfig& base,
+                                            const EvaluationOptions& options,
+                                            std::string_view choice) {
   if (choice != "inekf" && choice != "eskf" && choice != "both") {
     throw std::invalid_argument("filter must be inekf, eskf or both, got '" +
                                 std::string(choice) + "'");
   }
-  std::vector<std::pair<std::string, FilterKind>> kinds;
-  if (choice != "eskf") kinds.emplace_back("InEKF", FilterKind::kLeftInekf);
-  if (choice != "inekf") kinds.emplace_back("ESKF", FilterKind::kQuaternionEskf);
-  return kinds;
+  std::vector<NamedEvaluationRun> runs;
+  for (const FilterKind kind : {FilterKind::kLeftInekf, FilterKind::kQuaternionEskf}) {
+    const bool inekf = kind == FilterKind::kLeftInekf;
+    if (choice != "both" && (choice == "inekf") != inekf) continue;
+    EstimatorConfig config = base;
+    config.filter = kind;
+    runs.push_back({inekf ? "InEKF" : "ESKF", run_evaluation(data, config, options)});
+  }
+  return runs;
 }
 
 EvaluationMetrics score(const std::vector<EvaluationSample>& samples,

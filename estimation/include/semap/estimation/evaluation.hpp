@@ -2,7 +2,6 @@
 
 #include <string>
 #include <string_view>
-#include <utility>
 #include <vector>
 
 #include "semap/estimation/estimator.hpp"
@@ -45,9 +44,17 @@ struct EvaluationRun {
 EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
                              const EvaluationOptions& options);
 
-// The filters an evaluation tool runs for its --filter choice ("inekf", "eskf" or "both",
-// InEKF first), with the names the tools print. Throws std::invalid_argument otherwise.
-std::vector<std::pair<std::string, FilterKind>> filters_to_evaluate(std::string_view choice);
+struct NamedEvaluationRun {
+  std::string name;  // "InEKF" or "ESKF", as the tools print it
+  EvaluationRun run;
+};
+
+// run_evaluation with `base` for each filter of an evaluation tool's --filter choice ("inekf",
+// "eskf" or "both", InEKF first). Throws std::invalid_argument for another choice.
+std::vector<NamedEvaluationRun> run_filters(const SimulationData& data,
+                                            const EstimatorConfig& base,
+                                            const EvaluationOptions& options,
+                                            std::string_view choice);
 
 // Metrics of already collected samples (t >= options.metrics_after_s).
 EvaluationMetrics score(const std::vector<EvaluationSample>& samples,
