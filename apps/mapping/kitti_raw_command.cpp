@@ -15,6 +15,7 @@
 #include "map_options.hpp"
 #include "progress_meter.hpp"
 #include "scan_timing.hpp"
+#include "semap/common/config.hpp"
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/oxts_reader.hpp"
 #include "semap/estimation/pose_history.hpp"
@@ -221,22 +222,23 @@ int run(const CLI::App& command, const RawOptions& o) {
               labels->describe().c_str());
   if (packet) {
     std::printf("noise model: GNSS fix = OXTS position + white noise of the packet's pos_accuracy "
-                "per axis (floor %.2f m, seed %llu)\n",
+                "per axis (floor %.2f m, seed %llu)",
                 est::kMinPacketSigmaM, static_cast<unsigned long long>(o.seed));
   } else {
     std::printf("noise model: GNSS fix = OXTS position + white noise sigma %.2f m per axis "
-                "(seed %llu); IMU = the packets' accelerations and rates as recorded\n",
+                "(seed %llu)",
                 sigma, static_cast<unsigned long long>(o.seed));
   }
+  std::printf("; IMU = the packets' accelerations and rates as recorded\n");
   std::printf("OXTS packets %zu over %.1f s, scans %zu\n", oxts.records.size(),
               common::seconds_between(oxts.records.back().stamp, oxts.records.front().stamp),
               drive.scans.size());
 
   est::EstimatorConfig base;
   base.imu_limits.max_dt_s = std::max(base.imu_limits.max_dt_s, 0.25);  // 10 Hz sync packets
-  // The first packet's heading as the initial guess, trusted to a few degrees (the paper starts
-  // its filter from the OXTS solution too); left at the default ~uniform sigma, the heading
-  // would wander while the car stands and dominate the RMSE until it converges from motion.
+  // The first packet's heading as the initial guess, trusted to a few degrees: left at the
+  // default ~uniform sigma, the heading wanders while the car stands and dominates the RMSE
+  // until motion makes it observable.
   base.init.yaw_rad = est::yaw_of(data.truth.front().state.rotation);
   base.init.yaw_sigma_rad = o.initial_yaw_sigma_deg * std::numbers::pi / 180.0;
   est::EvaluationOptions eval;
@@ -263,6 +265,7 @@ int run(const CLI::App& command, const RawOptions& o) {
   ProgressMeter meter("semap-kitti raw", o.progress_seconds);
   const ScanStats s =
       map_scans(drive, o.first, last, history, *labels, camera, body_from_velo, map, meter);
+  const double mapping_seconds = meter.elapsed_seconds();
   std::printf("scans %zu mapped %zu without_pose %zu soft_labelled %zu (posed by %s, no deskew)\n",
               last - o.first + 1, s.mapped, s.without_pose, s.soft, runs.front().name.c_str());
   std::printf("points %llu inserted %llu out_of_image %llu out_of_range %llu no_label %llu "
@@ -275,25 +278,26 @@ int run(const CLI::App& command, const RawOptions& o) {
   print_timing("label_ms (segmentation + projection)", s.label_seconds);
   print_timing("insert_ms", s.insert_seconds);
   write_map_outputs(o.out, map);
-  std::printf("wall_seconds %.2f threads %zu\n", meter.elapsed_seconds(),
+  std::printf("wall_seconds %.2f threads %zu\n", mapping_seconds,
               tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   return 0;
+}
+
+// Errors about the user's files (each names the file): exit status 2.
+bool is_bad_input(const std::exception& e) {
+  return dynamic_cast<const DriveError*>(&e) != nullptr ||
+         dynamic_cast<const perception::CalibrationError*>(&e) != nullptr ||
+         dynamic_cast<const map_io::KittiError*>(&e) != nullptr ||
+         dynamic_cast<const common::ConfigError*>(&e) != nullptr;  // model card
 }
 
 int run_guarded(const CLI::App& command, const RawOptions& o) {
   try {
     return run(command, o);
-  } catch (const DriveError& e) {
-    std::fprintf(stderr, "semap-kitti raw: %s\n", e.what());
-  } catch (const perception::CalibrationError& e) {
-    std::fprintf(stderr, "semap-kitti raw: %s\n", e.what());
-  } catch (const map_io::KittiError& e) {
-    std::fprintf(stderr, "semap-kitti raw: %s\n", e.what());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "semap-kitti raw: %s\n", e.what());
-    return 1;
+    return is_bad_input(e) ? 2 : 1;
   }
-  return 2;  // bad input, named above
 }
 
 }  // namespace
