@@ -2,6 +2,7 @@
 // filter beats its GNSS, the map holds the street's classes where the street has them, and bad
 // input is named with exit status 2.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -38,8 +39,7 @@ double figure(const std::string& out, const std::string& key) {
 
 fs::path temp_dir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() /
-                       ("semap_kitti_raw_" + name + "_" +
-                        std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+                       ("semap_kitti_raw_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
