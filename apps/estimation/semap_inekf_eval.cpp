@@ -94,16 +94,10 @@ int main(int argc, char** argv) {
     base.init.yaw_rad = est::yaw_of(data.truth.front().state.rotation) +
                         heading_error_deg * std::numbers::pi / 180.0;
 
-    std::vector<std::pair<std::string, est::FilterKind>> kinds;
-    if (filter != "eskf") kinds.emplace_back("InEKF", est::FilterKind::kLeftInekf);
-    if (filter != "inekf") kinds.emplace_back("ESKF", est::FilterKind::kQuaternionEskf);
-    std::vector<est::EvaluationRun> runs;
-    for (const auto& [name, kind] : kinds) {
-      est::EstimatorConfig config = base;
-      config.filter = kind;
-      runs.push_back(est::run_evaluation(data, config, options));
-      const auto& m = runs.back().metrics;
-      const auto& c = runs.back().counters;
+    const auto runs = est::run_filters(data, base, options, filter);
+    for (const auto& [name, run] : runs) {
+      const auto& m = run.metrics;
+      const auto& c = run.counters;
       std::printf(
           "%-5s ATE %.3f m | heading RMSE %.3f deg | RPE(10 s) %.3f m, %.3f deg | mean NEES %.2f "
           "(9 dof) | heading < 2 deg after %.1f s | GNSS applied %llu, gated %llu, re-anchors "
@@ -116,10 +110,8 @@ int main(int argc, char** argv) {
           static_cast<unsigned long long>(c.position_inflations),
           static_cast<unsigned long long>(c.imu.rejected()));
     }
-    std::vector<semap::apps::LabelledRun> labelled;
-    for (std::size_t i = 0; i < runs.size(); ++i) labelled.push_back({kinds[i].first, &runs[i]});
-    if (!csv_path.empty()) semap::apps::write_csv(csv_path, labelled);
-    if (!png_path.empty()) semap::apps::write_top_view(png_path, data, labelled);
+    if (!csv_path.empty()) semap::apps::write_csv(csv_path, runs);
+    if (!png_path.empty()) semap::apps::write_top_view(png_path, data, runs);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "semap-inekf-eval: %s\n", e.what());
     return 1;

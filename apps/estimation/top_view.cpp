@@ -21,7 +21,7 @@ const std::array<cv::Scalar, 3> kColours = {cv::Scalar(200, 80, 0), cv::Scalar(0
 }  // namespace
 
 void write_top_view(const std::filesystem::path& path, const estimation::SimulationData& data,
-                    const std::vector<LabelledRun>& runs) {
+                    const std::vector<estimation::NamedEvaluationRun>& runs, const std::string& truth_label) {
   const estimation::LocalEnu enu(data.origin);
   std::vector<Eigen::Vector3d> fixes;
   for (const auto& f : data.gnss) {
@@ -36,7 +36,7 @@ void write_top_view(const std::filesystem::path& path, const estimation::Simulat
   };
   for (const auto& t : data.truth) grow(t.state.position);
   for (const auto& r : runs) {
-    for (const auto& s : r.run->samples) grow(s.estimate.position);
+    for (const auto& s : r.run.samples) grow(s.estimate.position);
   }
   const double span = std::max({max_x - min_x, max_y - min_y, 1.0});
   const double scale = (kSize - 2 * kMargin) / span;
@@ -50,14 +50,14 @@ void write_top_view(const std::filesystem::path& path, const estimation::Simulat
   for (const auto& t : data.truth) line.push_back(pixel(t.state.position));
   cv::polylines(image, line, false, cv::Scalar(0, 150, 0), 2, cv::LINE_AA);
   int legend_y = 25;
-  cv::putText(image, "truth", {10, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 150, 0}, 2);
+  cv::putText(image, truth_label, {10, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, {0, 150, 0}, 2);
   for (std::size_t i = 0; i < runs.size(); ++i) {
     line.clear();
-    for (const auto& s : runs[i].run->samples) line.push_back(pixel(s.estimate.position));
+    for (const auto& s : runs[i].run.samples) line.push_back(pixel(s.estimate.position));
     const cv::Scalar colour = kColours[i % kColours.size()];
     cv::polylines(image, line, false, colour, 1, cv::LINE_AA);
     legend_y += 22;
-    cv::putText(image, runs[i].label, {10, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, colour, 2);
+    cv::putText(image, runs[i].name, {10, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, colour, 2);
   }
   cv::putText(image, "GNSS fixes (grey); " + std::to_string(static_cast<int>(span)) + " m across",
               {10, kSize - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {90, 90, 90}, 1);
@@ -66,7 +66,7 @@ void write_top_view(const std::filesystem::path& path, const estimation::Simulat
   }
 }
 
-void write_csv(const std::filesystem::path& path, const std::vector<LabelledRun>& runs) {
+void write_csv(const std::filesystem::path& path, const std::vector<estimation::NamedEvaluationRun>& runs) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
   constexpr double kDeg = 180.0 / std::numbers::pi;
@@ -74,8 +74,8 @@ void write_csv(const std::filesystem::path& path, const std::vector<LabelledRun>
          "heading_error_deg,nees\n";
   out.precision(10);
   for (const auto& r : runs) {
-    for (const auto& s : r.run->samples) {
-      out << r.label << ',' << s.t << ',' << s.truth.position.x() << ',' << s.truth.position.y()
+    for (const auto& s : r.run.samples) {
+      out << r.name << ',' << s.t << ',' << s.truth.position.x() << ',' << s.truth.position.y()
           << ',' << s.truth.position.z() << ',' << s.estimate.position.x() << ','
           << s.estimate.position.y() << ',' << s.estimate.position.z() << ','
           << estimation::yaw_of(s.truth.rotation) * kDeg << ','

@@ -12,6 +12,7 @@
 
 #include "map_options.hpp"
 #include "progress_meter.hpp"
+#include "scan_timing.hpp"
 #include "semap/map_io/kitti_iou_table.hpp"
 #include "semap/map_io/kitti_semantic_eval.hpp"
 
@@ -35,12 +36,6 @@ struct SemanticOptions {
 
 const char* row_name(mapping::MapMethod method) {
   return method == mapping::MapMethod::kBki ? "S-BKI" : "S-CSM";
-}
-
-// Nearest-rank percentile of the sorted `values` (not empty), in milliseconds.
-double percentile_ms(const std::vector<double>& sorted, double fraction) {
-  const auto rank = static_cast<std::size_t>(fraction * static_cast<double>(sorted.size()));
-  return 1e3 * sorted[std::min(rank, sorted.size() - 1)];
 }
 
 // The largest resident set of the process so far (Linux reports KiB).

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include "semap/estimation/so3.hpp"
 
@@ -54,6 +55,25 @@ EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
   run.metrics = score(run.samples, options);
   run.counters = estimator.counters();
   return run;
+}
+
+std::vector<NamedEvaluationRun> run_filters(const SimulationData& data,
+                                            const EstimatorConfig& base,
+                                            const EvaluationOptions& options,
+                                            std::string_view choice) {
+  if (choice != "inekf" && choice != "eskf" && choice != "both") {
+    throw std::invalid_argument("filter must be inekf, eskf or both, got '" +
+                                std::string(choice) + "'");
+  }
+  std::vector<NamedEvaluationRun> runs;
+  for (const FilterKind kind : {FilterKind::kLeftInekf, FilterKind::kQuaternionEskf}) {
+    const bool inekf = kind == FilterKind::kLeftInekf;
+    if (choice != "both" && (choice == "inekf") != inekf) continue;
+    EstimatorConfig config = base;
+    config.filter = kind;
+    runs.push_back({inekf ? "InEKF" : "ESKF", run_evaluation(data, config, options)});
+  }
+  return runs;
 }
 
 EvaluationMetrics score(const std::vector<EvaluationSample>& samples,

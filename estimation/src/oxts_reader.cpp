@@ -210,7 +210,8 @@ OxtsData read_oxts_folder(const std::filesystem::path& dir) {
   return out;
 }
 
-SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed) {
+SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
+                              OxtsGnssNoise noise) {
   SimulationData out;
   if (data.records.empty()) return out;
   const auto& first = data.records.front();
@@ -234,16 +235,18 @@ SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::ui
     imu.accel = r.accel;
     out.imu.push_back(imu);
 
+    const double sigma = noise == OxtsGnssNoise::kPacketAccuracy
+                             ? std::max(r.position_accuracy_m, kMinPacketSigmaM)
+                             : gnss_sigma_m;
     const Eigen::Vector3d noisy =
-        truth.state.position +
-        gnss_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+        truth.state.position + sigma * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
     const Geodetic g = enu.to_geodetic(noisy);
     common::GnssFix fix;
     fix.stamp = r.stamp;
     fix.latitude_deg = g.latitude_deg;
     fix.longitude_deg = g.longitude_deg;
     fix.altitude_m = g.altitude_m;
-    fix.covariance = Eigen::Matrix3d::Identity() * gnss_sigma_m * gnss_sigma_m;
+    fix.covariance = Eigen::Matrix3d::Identity() * sigma * sigma;
     fix.quality = common::FixQuality::kGps;
     fix.mode = common::FixMode::k3D;
     fix.satellites = static_cast<std::uint8_t>(std::clamp(r.satellites, 0, 255));

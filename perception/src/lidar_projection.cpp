@@ -26,8 +26,7 @@ KittiCameraCalibration KittiCameraCalibration::from_text(const KittiCalibText& c
   calib.p_rect = cam_to_cam.matrix<3, 4>("P_rect" + index);
   // Every rectified camera shares camera 0's rectifying rotation.
   calib.r_rect = cam_to_cam.matrix<3, 3>("R_rect_00");
-  calib.cam_from_lidar.linear() = velo_to_cam.matrix<3, 3>("R");
-  calib.cam_from_lidar.translation() = velo_to_cam.matrix<3, 1>("T");
+  calib.cam_from_lidar = velo_to_cam.rigid_transform();
   return calib;
 }
 

@@ -167,6 +167,40 @@ TEST(KittiCameraCalibration, LoadsRealFiles) {
       std::invalid_argument);
 }
 
+// More points through the real 2011_09_26 calibration (semap-kitti raw's projection). Pixels
+// worked out apart from this code: P_rect_02 * R_rect_00 * [R T] of the files, multiplied out
+// in plain Python. (6, 3, -1.7) lands below the image (v = 389.9 > 375), (-5, 0, 0) behind it.
+TEST(KittiCameraCalibration, RealCalibrationPixels) {
+  const auto dir = std::filesystem::path(SEMAP_SHARED_DATA_DIR) / "kitti/2011_09_26";
+  const auto calib =
+      KittiCameraCalibration::load(dir / "calib_cam_to_cam.txt", dir / "calib_velo_to_cam.txt");
+  struct Case {
+    Eigen::Vector3f lidar;
+    float u, v, depth;
+  };
+  const std::vector<Case> cases = {{{15, 0, 0}, 612.53f, 176.84f, 14.73f},
+                                   {{10, 2, -1.5f}, 466.61f, 287.98f, 9.715f},
+                                   {{20, -5, 1}, 794.19f, 139.25f, 19.739f}};
+  const Eigen::Matrix<float, 3, 4> m = calib.image_from_lidar();
+  std::vector<Eigen::Vector3f> points;
+  for (const Case& c : cases) {
+    const Eigen::Vector3f y = m * c.lidar.homogeneous();
+    EXPECT_NEAR(y.x() / y.z(), c.u, 0.02f);
+    EXPECT_NEAR(y.y() / y.z(), c.v, 0.02f);
+    EXPECT_NEAR(y.z(), c.depth, 0.002f);
+    points.push_back(c.lidar);
+  }
+  points.emplace_back(6.0f, 3.0f, -1.7f);
+  points.emplace_back(-5.0f, 0.0f, 0.0f);
+  DropCounts drops;
+  PointOptions options;
+  options.max_range = 50.0f;
+  const auto cloud = label_lidar_points(points, make_segmentation(1242, 375, kClasses, false), calib,
+                                        Eigen::Isometry3f::Identity(), options, drops);
+  EXPECT_EQ(cloud.size(), 3u);
+  EXPECT_EQ(drops.out_of_image, 2u);
+}
+
 std::string error_of(std::string_view cam_to_cam, std::string_view velo_to_cam) {
   try {
     KittiCameraCalibration::from_text(KittiCalibText(cam_to_cam, "cam.txt"),

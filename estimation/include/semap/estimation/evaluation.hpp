@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "semap/estimation/estimator.hpp"
@@ -41,6 +43,18 @@ struct EvaluationRun {
 // the truth. The estimator is anchored at data.origin so truth and estimate share a frame.
 EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
                              const EvaluationOptions& options);
+
+struct NamedEvaluationRun {
+  std::string name;  // "InEKF" or "ESKF", as the tools print it
+  EvaluationRun run;
+};
+
+// run_evaluation with `base` for each filter of an evaluation tool's --filter choice ("inekf",
+// "eskf" or "both", InEKF first). Throws std::invalid_argument for another choice.
+std::vector<NamedEvaluationRun> run_filters(const SimulationData& data,
+                                            const EstimatorConfig& base,
+                                            const EvaluationOptions& options,
+                                            std::string_view choice);
 
 // Metrics of already collected samples (t >= options.metrics_after_s).
 EvaluationMetrics score(const std::vector<EvaluationSample>& samples,

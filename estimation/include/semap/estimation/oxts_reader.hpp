@@ -53,9 +53,17 @@ struct OxtsData {
 // Bad records are skipped and reported in `errors`; a missing folder throws.
 OxtsData read_oxts_folder(const std::filesystem::path& dir);
 
+// Which sigma the simulated GNSS fixes get: one configured value for every fix, or each
+// packet's own pos_accuracy (the OXTS unit's 1-sigma estimate, floored at kMinPacketSigmaM so a
+// packet reporting 0 still gives an invertible covariance).
+enum class OxtsGnssNoise : std::uint8_t { kFixedSigma, kPacketAccuracy };
+inline constexpr double kMinPacketSigmaM = 0.01;
+
 // Turns OXTS records into estimator inputs: IMU samples from the rates and accelerations,
-// GNSS fixes from the positions plus white noise of gnss_sigma_m, and the OXTS solution as
+// GNSS fixes from the positions plus seeded white noise (gnss_sigma_m per axis, or the packet's
+// pos_accuracy with kPacketAccuracy) and that sigma as covariance, and the OXTS solution as
 // truth (biases unknown, left zero), anchored at the first record.
-SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed);
+SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
+                              OxtsGnssNoise noise = OxtsGnssNoise::kFixedSigma);
 
 }  // namespace semap::estimation

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -42,6 +43,15 @@ class KittiCalibText {
     // Eigen allows a row-major layout only for matrices with more than one column.
     constexpr int kLayout = Cols == 1 ? Eigen::ColMajor : Eigen::RowMajor;
     return Eigen::Map<const Eigen::Matrix<double, Rows, Cols, kLayout>>(v.data());
+  }
+
+  // The rigid transform of a `R:` (3x3, row by row) and `T:` (3) pair, as calib_velo_to_cam.txt
+  // (camera 0 from Velodyne) and calib_imu_to_velo.txt (Velodyne from IMU) store it.
+  Eigen::Isometry3d rigid_transform() const {
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = matrix<3, 3>("R");
+    t.translation() = matrix<3, 1>("T");
+    return t;
   }
 
   // An image size stored as two numbers `width height` (S_rect_xx), positive whole pixels.
