@@ -49,9 +49,44 @@ std::size_t expected_size(const common::ImageFrame& frame) {
   return static_cast<std::size_t>(frame.stride) * frame.height;
 }
 
+namespace {
+
+// Bytes of one pixel in the frame (YUYV: 2 per pixel, 4 per pixel pair).
+std::size_t bytes_per_pixel(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kYuyv:
+    case PixelFormat::kZ16:
+      return 2;
+    case PixelFormat::kGrey:
+      return 1;
+    case PixelFormat::kBgr24:
+      return 3;
+    case PixelFormat::kMjpeg:
+      break;
+  }
+  return 0;
+}
+
+}  // namespace
+
 cv::Mat to_mat(const common::ImageFrame& frame, JpegDecoder& jpeg) {
-  if (frame.format == PixelFormat::kMjpeg) return jpeg.decode_bgr(frame.data);
-  if (frame.width == 0 || frame.height == 0 || frame.data.size() < expected_size(frame)) {
+  if (frame.width > kMaxImageSide || frame.height > kMaxImageSide) return {};
+  if (frame.format == PixelFormat::kMjpeg) {
+    // The JPEG's own header decides the allocation: it must describe the frame's image.
+    const auto info = jpeg.header(frame.data);
+    if (!info || static_cast<std::uint32_t>(info->width) != frame.width ||
+        static_cast<std::uint32_t>(info->height) != frame.height) {
+      return {};
+    }
+    return jpeg.decode_bgr(frame.data);
+  }
+  // A row shorter than the pixels it must hold would make the rows overlap (or, with stride
+  // 0, read past the frame); YUYV packs pixel pairs; Z16 rows start on a 16-bit sample.
+  if (frame.width == 0 || frame.height == 0 ||
+      frame.stride < frame.width * bytes_per_pixel(frame.format) ||
+      (frame.format == PixelFormat::kYuyv && frame.width % 2 != 0) ||
+      (frame.format == PixelFormat::kZ16 && frame.stride % 2 != 0) ||
+      frame.data.size() < expected_size(frame)) {
     return {};
   }
   // cv::Mat views the frame's bytes with its stride; the conversions below copy.

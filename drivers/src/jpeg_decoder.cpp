@@ -24,7 +24,12 @@ std::optional<JpegInfo> JpegDecoder::header(std::span<const std::uint8_t> jpeg) 
 
 cv::Mat JpegDecoder::decode_bgr(std::span<const std::uint8_t> jpeg) {
   const auto info = header(jpeg);
-  if (!info) return {};
+  // The header alone sizes the allocation: refuse sizes no camera sends (a 12-byte header can
+  // claim 65535 x 65535).
+  if (!info || info->width <= 0 || info->height <= 0 ||
+      static_cast<std::int64_t>(info->width) * info->height > kMaxJpegPixels) {
+    return {};
+  }
   cv::Mat out(info->height, info->width, CV_8UC3);
   // Warnings (e.g. a few missing bytes at the end, common with MJPEG webcams) still give a
   // usable image; only hard errors reject the frame.

@@ -210,5 +210,52 @@ TEST(FrameConvert, MjpegSaturatedColoursSurviveEncodeAndDecode) {
   }
 }
 
+// Found by frame_convert_fuzz (in 11 runs): a stride shorter than a row made cv::Mat throw,
+// and stride 0 (cv::Mat's "rows are packed") read past the frame's bytes.
+TEST(FrameConvert, StrideShorterThanARowGivesEmptyMat) {
+  JpegDecoder jpeg;
+  auto grey = raw_frame(PixelFormat::kGrey, 8, 8, 1);
+  grey.stride = 7;
+  EXPECT_TRUE(to_mat(grey, jpeg).empty());
+  auto bgr = raw_frame(PixelFormat::kBgr24, 4, 2, 3);
+  bgr.stride = 0;
+  bgr.data.clear();
+  EXPECT_TRUE(to_mat(bgr, jpeg).empty());
+  auto yuyv = raw_frame(PixelFormat::kYuyv, 3, 2, 2);  // YUYV holds pixel pairs
+  EXPECT_TRUE(to_mat(yuyv, jpeg).empty());
+  // Found by frame_convert_fuzz: an odd Z16 stride made cv::Mat throw.
+  auto z16 = raw_frame(PixelFormat::kZ16, 2, 2, 2, 1);
+  EXPECT_TRUE(to_mat(z16, jpeg).empty());
+  auto huge = raw_frame(PixelFormat::kGrey, 1, 1, 1);
+  huge.width = kMaxImageSide + 1;
+  EXPECT_TRUE(to_mat(huge, jpeg).empty());
+}
+
+// Issue 20, asserted by frame_convert_fuzz: the JPEG header alone sized the decoded image (a
+// few bytes can claim 65535 x 65535); now it must match the frame's width and height.
+TEST(FrameConvert, MjpegWhoseHeaderDiffersFromTheFrameGivesEmptyMat) {
+  cv::Mat src(16, 24, CV_8UC3, cv::Scalar(30, 120, 220));
+  tjhandle enc = tjInitCompress();
+  unsigned char* jpeg_buf = nullptr;
+  unsigned long jpeg_size = 0;
+  ASSERT_EQ(tjCompress2(enc, src.data, src.cols, static_cast<int>(src.step), src.rows, TJPF_BGR,
+                        &jpeg_buf, &jpeg_size, TJSAMP_444, 95, 0),
+            0);
+  ImageFrame f;
+  f.format = PixelFormat::kMjpeg;
+  f.data.assign(jpeg_buf, jpeg_buf + jpeg_size);
+  tjFree(jpeg_buf);
+  tjDestroy(enc);
+  JpegDecoder jpeg;
+  f.width = 24;
+  f.height = 16;
+  EXPECT_EQ(to_mat(f, jpeg).size(), cv::Size(24, 16));
+  f.height = 8;
+  EXPECT_TRUE(to_mat(f, jpeg).empty());
+  f.width = 0;
+  f.height = 0;
+  EXPECT_TRUE(to_mat(f, jpeg).empty());
+}
+
 }  // namespace
 }  // namespace semap::drivers

@@ -22,7 +22,10 @@ class JpegDecoder {
 
   // Parses the header only; nullopt if the bytes are not a JPEG image.
   std::optional<JpegInfo> header(std::span<const std::uint8_t> jpeg);
-  // Decodes to BGR; an empty Mat if the data is corrupt.
+  // Most pixels decode_bgr allocates for (8192 x 8192).
+  static constexpr std::int64_t kMaxJpegPixels = std::int64_t{8192} * 8192;
+
+  // Decodes to BGR; an empty Mat if the data is corrupt or claims more than kMaxJpegPixels.
   cv::Mat decode_bgr(std::span<const std::uint8_t> jpeg);
 
  private:
