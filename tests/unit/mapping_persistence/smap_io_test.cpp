@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 #include "test_maps.hpp"
 
@@ -175,6 +176,26 @@ TEST_F(SmapIo, SalvageOfCutSingleLayerKeepsEveryBlockBeforeTheCut) {
   } catch (const SmapError& e) {
     EXPECT_THAT(e.what(), HasSubstr("layer 0"));
   }
+}
+
+// Found by smap_crc_fixed_fuzz: a header whose prior (7.7e66 in the crash input) is a finite
+// double beyond float range was accepted, and semantic_params turned it into inf; the bki.*
+// settings, also floats in MapParams, had the same hole.
+TEST(SmapHeader, ParametersBeyondFloatRangeAreRefused) {
+  LayeredMapParams p = testing::small_logodds_params();
+  p.method = MapMethod::kBki;
+  p.extra["bki.ell"] = 0.3;
+  EXPECT_NO_THROW(validate(p));
+  p.extra["bki.ell"] = 1e300;
+  try {
+    validate(p);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("bki.ell"));
+  }
+  p.extra["bki.ell"] = 0.3;
+  p.prior = 1e300;
+  EXPECT_THROW(validate(p), std::invalid_argument);
 }
 
 TEST_F(SmapIo, RejectsOtherFilesAndVersions) {
