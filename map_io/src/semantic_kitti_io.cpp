@@ -92,7 +92,8 @@ std::vector<std::uint32_t> read_kitti_labels(const std::filesystem::path& path) 
                      " is not a multiple of 4 bytes");
   }
   std::vector<std::uint32_t> labels(bytes.size() / sizeof(std::uint32_t));
-  std::memcpy(labels.data(), bytes.data(), bytes.size());
+  // An empty file gives no labels (memcpy must not see the empty vector's null pointer).
+  if (!labels.empty()) std::memcpy(labels.data(), bytes.data(), bytes.size());
   return labels;
 }
 

@@ -63,6 +63,15 @@ TEST(KittiLearningMap, MapsOfficialIdsAndIgnoresInstanceBits) {
   EXPECT_STREQ(kitti_class_names()[13], "building");
 }
 
+// Found by kitti_readers_fuzz (UBSan: memcpy from an empty file into the empty vector's null
+// pointer); an empty scan or label file holds no points.
+TEST_F(KittiFiles, EmptyScanAndLabelFilesGiveNothing) {
+  std::ofstream(dir_ / "empty.label", std::ios::binary).flush();
+  std::ofstream(dir_ / "empty.bin", std::ios::binary).flush();
+  EXPECT_TRUE(read_kitti_labels(dir_ / "empty.label").empty());
+  EXPECT_TRUE(read_kitti_scan(dir_ / "empty.bin").empty());
+}
+
 TEST_F(KittiFiles, MalformedFilesNameFileAndLine) {
   std::ofstream(dir_ / "poses.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0\n";
   try {
