@@ -79,10 +79,13 @@ odom += struct.pack("<36d", *[0.02 if i % 7 == 0 else 0.0 for i in range(36)])
 write("dds_from_msg_fuzz", "odometry", odom)
 
 # kitti_readers_fuzz: kind 0 .bin, 1 .label, 2 poses.txt, 3 calib.txt.
-write("kitti_readers_fuzz", "scan.bin", bytes([0]) + struct.pack("<8f", 1, 2, 3, 0.5, -4, 0, 1, 0.1))
-write("kitti_readers_fuzz", "labels.label", bytes([1]) + struct.pack("<3I", 40, 10 | (7 << 16), 252))
+write("kitti_readers_fuzz", "scan.bin",
+      bytes([0]) + struct.pack("<8f", 1, 2, 3, 0.5, -4, 0, 1, 0.1))
+write("kitti_readers_fuzz", "labels.label",
+      bytes([1]) + struct.pack("<3I", 40, 10 | (7 << 16), 252))
 write("kitti_readers_fuzz", "poses.txt", bytes([2]) + b"1 0 0 0 0 1 0 0 0 0 1 0\n"
       b"1.000000e+00 0 0 0.5 0 1 0 0 0 0 1 1.25\n\n")
-write("kitti_readers_fuzz", "calib.txt", bytes([3]) + b"P0: 7.07e+02 0 6.0e+02 0 0 7.07e+02 1.8e+02 0 0 0 1 0\n"
+write("kitti_readers_fuzz", "calib.txt", bytes([3]) +
+      b"P0: 7.07e+02 0 6.0e+02 0 0 7.07e+02 1.8e+02 0 0 0 1 0\n"
       b"Tr: 4.27e-04 -9.99e-01 -8.08e-03 -1.19e-02 -7.21e-03 8.08e-03 -9.99e-01 -5.40e-02 "
       b"9.99e-01 4.85e-04 -7.20e-03 -2.92e-01\n")
