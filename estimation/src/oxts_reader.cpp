@@ -59,6 +59,12 @@ std::optional<OxtsRecord> parse_oxts_line(std::string_view line, std::string& er
     error = "field 1/2 (lat/lon): out of range";
     return std::nullopt;
   }
+  // A satellite count becomes an int: a count no receiver reports (beyond int, found by
+  // oxts_fuzz as undefined behaviour) is refused.
+  if (v[26] < 0.0 || v[26] > 1000.0) {
+    error = "field 27 (" + std::string(kFieldNames[26]) + "): out of range";
+    return std::nullopt;
+  }
   OxtsRecord r;
   r.latitude_deg = v[0];
   r.longitude_deg = v[1];
