@@ -21,7 +21,8 @@ const std::array<cv::Scalar, 3> kColours = {cv::Scalar(200, 80, 0), cv::Scalar(0
 }  // namespace
 
 void write_top_view(const std::filesystem::path& path, const estimation::SimulationData& data,
-                    const std::vector<estimation::NamedEvaluationRun>& runs, const std::string& truth_label) {
+                    const std::vector<estimation::NamedEvaluationRun>& runs,
+                    const std::string& truth_label) {
   const estimation::LocalEnu enu(data.origin);
   std::vector<Eigen::Vector3d> fixes;
   for (const auto& f : data.gnss) {
@@ -66,7 +67,8 @@ void write_top_view(const std::filesystem::path& path, const estimation::Simulat
   }
 }
 
-void write_csv(const std::filesystem::path& path, const std::vector<estimation::NamedEvaluationRun>& runs) {
+void write_csv(const std::filesystem::path& path,
+               const std::vector<estimation::NamedEvaluationRun>& runs) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path.string() + ": cannot open for writing");
   constexpr double kDeg = 180.0 / std::numbers::pi;

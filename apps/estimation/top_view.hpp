@@ -11,9 +11,11 @@ namespace semap::apps {
 // Top view (east right, north up) of the truth (named `truth_label` in the legend), each
 // estimate and the GNSS fixes, as PNG.
 void write_top_view(const std::filesystem::path& path, const estimation::SimulationData& data,
-                    const std::vector<estimation::NamedEvaluationRun>& runs, const std::string& truth_label = "truth");
+                    const std::vector<estimation::NamedEvaluationRun>& runs,
+                    const std::string& truth_label = "truth");
 
 // One row per sample and filter: t, truth and estimated position and yaw, heading error, NEES.
-void write_csv(const std::filesystem::path& path, const std::vector<estimation::NamedEvaluationRun>& runs);
+void write_csv(const std::filesystem::path& path,
+               const std::vector<estimation::NamedEvaluationRun>& runs);
 
 }  // namespace semap::apps

@@ -142,8 +142,8 @@ ScanStats map_scans(const KittiRawDrive& drive, std::size_t first, std::size_t l
     for (std::size_t k = 0; k < raw.size(); ++k) points[k] = raw[k].head<3>();
     auto start = std::chrono::steady_clock::now();
     const perception::Segmentation seg = labels.labels_for(drive.scans[i]);
-    common::LabeledCloud body = perception::label_lidar_points(points, seg, camera, body_from_velo,
-                                                               options, stats.drops);
+    common::LabeledCloud body =
+        perception::label_lidar_points(points, seg, camera, body_from_velo, options, stats.drops);
     Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
     world_from_body.linear() = pose->orientation.toRotationMatrix().cast<float>();
     world_from_body.translation() = pose->position.cast<float>();
@@ -190,9 +190,8 @@ int run(const CLI::App& command, const RawOptions& o) {
           .cast<float>();
   const KittiRawDrive drive = open_kitti_raw_drive(drive_dir);
   std::unique_ptr<ScanLabelSource> labels =
-      o.segmenter.empty()
-          ? make_label_image_source(o.labels, params.num_classes)
-          : make_model_label_source(o.segmenter, drive_dir / "image_02" / "data");
+      o.segmenter.empty() ? make_label_image_source(o.labels, params.num_classes)
+                          : make_model_label_source(o.segmenter, drive_dir / "image_02" / "data");
   params.num_classes = labels->num_classes();
   params.validate();
 
@@ -203,10 +202,10 @@ int run(const CLI::App& command, const RawOptions& o) {
     throw DriveError(e.what());
   }
   if (!oxts.errors.empty()) {
-    throw DriveError(oxts.errors.front() + (oxts.errors.size() > 1
-                                                ? " (and " + std::to_string(oxts.errors.size() - 1) +
-                                                      " more bad packets)"
-                                                : ""));
+    throw DriveError(oxts.errors.front() +
+                     (oxts.errors.size() > 1
+                          ? " (and " + std::to_string(oxts.errors.size() - 1) + " more bad packets)"
+                          : ""));
   }
   if (oxts.records.size() < 20) {
     throw DriveError((drive_dir / "oxts").string() + ": too few packets (" +
@@ -221,13 +220,15 @@ int run(const CLI::App& command, const RawOptions& o) {
   std::printf("drive %s\ncalibration %s\nlabels %s\n", drive_dir.c_str(), calib_dir.c_str(),
               labels->describe().c_str());
   if (packet) {
-    std::printf("noise model: GNSS fix = OXTS position + white noise of the packet's pos_accuracy "
-                "per axis (floor %.2f m, seed %llu)",
-                est::kMinPacketSigmaM, static_cast<unsigned long long>(o.seed));
+    std::printf(
+        "noise model: GNSS fix = OXTS position + white noise of the packet's pos_accuracy "
+        "per axis (floor %.2f m, seed %llu)",
+        est::kMinPacketSigmaM, static_cast<unsigned long long>(o.seed));
   } else {
-    std::printf("noise model: GNSS fix = OXTS position + white noise sigma %.2f m per axis "
-                "(seed %llu)",
-                sigma, static_cast<unsigned long long>(o.seed));
+    std::printf(
+        "noise model: GNSS fix = OXTS position + white noise sigma %.2f m per axis "
+        "(seed %llu)",
+        sigma, static_cast<unsigned long long>(o.seed));
   }
   std::printf("; IMU = the packets' accelerations and rates as recorded\n");
   std::printf("OXTS packets %zu over %.1f s, scans %zu\n", oxts.records.size(),
@@ -256,8 +257,8 @@ int run(const CLI::App& command, const RawOptions& o) {
   write_top_view(fs::path(o.out) / "top_view.png", data, runs, "OXTS");
 
   if (drive.scans.empty()) throw DriveError(drive_dir.string() + ": no scans");
-  const std::size_t last =
-      command.count("--last") > 0 ? std::min(o.last, drive.scans.size() - 1) : drive.scans.size() - 1;
+  const std::size_t last = command.count("--last") > 0 ? std::min(o.last, drive.scans.size() - 1)
+                                                       : drive.scans.size() - 1;
   if (o.first > last) throw DriveError("--first " + std::to_string(o.first) + " beyond the scans");
   // The map follows the first filter run (the InEKF unless --filter eskf).
   const est::PoseHistory history = history_of(runs.front().run, data.imu.front().stamp);
@@ -268,13 +269,14 @@ int run(const CLI::App& command, const RawOptions& o) {
   const double mapping_seconds = meter.elapsed_seconds();
   std::printf("scans %zu mapped %zu without_pose %zu soft_labelled %zu (posed by %s, no deskew)\n",
               last - o.first + 1, s.mapped, s.without_pose, s.soft, runs.front().name.c_str());
-  std::printf("points %llu inserted %llu out_of_image %llu out_of_range %llu no_label %llu "
-              "no_depth %llu\n",
-              static_cast<unsigned long long>(s.points), static_cast<unsigned long long>(s.inserted),
-              static_cast<unsigned long long>(s.drops.out_of_image),
-              static_cast<unsigned long long>(s.drops.out_of_range),
-              static_cast<unsigned long long>(s.drops.no_label),
-              static_cast<unsigned long long>(s.drops.no_depth));
+  std::printf(
+      "points %llu inserted %llu out_of_image %llu out_of_range %llu no_label %llu "
+      "no_depth %llu\n",
+      static_cast<unsigned long long>(s.points), static_cast<unsigned long long>(s.inserted),
+      static_cast<unsigned long long>(s.drops.out_of_image),
+      static_cast<unsigned long long>(s.drops.out_of_range),
+      static_cast<unsigned long long>(s.drops.no_label),
+      static_cast<unsigned long long>(s.drops.no_depth));
   print_timing("label_ms (segmentation + projection)", s.label_seconds);
   print_timing("insert_ms", s.insert_seconds);
   write_map_outputs(o.out, map);
@@ -310,8 +312,10 @@ void add_kitti_raw_command(CLI::App& app) {
       "Run the Left-InEKF (and ESKF) on a KITTI raw drive's OXTS-derived IMU and noisy GNSS, "
       "label each Velodyne scan through image_02 and build an S-BKI map; prints unaligned ATE, "
       "heading RMSE and per-scan timing (docs/kitti.md)");
-  command->add_option("--drive", o.drive, "a *_sync or *_extract folder (oxts/, velodyne_points/, "
-                                          "image_02/)")
+  command
+      ->add_option("--drive", o.drive,
+                   "a *_sync or *_extract folder (oxts/, velodyne_points/, "
+                   "image_02/)")
       ->required();
   command->add_option("--calib", o.calib,
                       "folder with calib_cam_to_cam.txt, calib_velo_to_cam.txt, "
@@ -321,7 +325,8 @@ void add_kitti_raw_command(CLI::App& app) {
   command->add_option("--gnss-sigma", o.gnss_sigma,
                       "GNSS white noise per axis, m, or `packet` for each packet's pos_accuracy");
   command->add_option("--seed", o.seed, "seed of the GNSS noise");
-  auto* seg = command->add_option("--segmenter", o.segmenter, "ONNX model card (YAML) for image_02");
+  auto* seg =
+      command->add_option("--segmenter", o.segmenter, "ONNX model card (YAML) for image_02");
   auto* lab = command->add_option("--labels", o.labels,
                                   "folder of 8-bit class-id PNGs, one per scan (NNNNNNNNNN.png)");
   seg->excludes(lab);
@@ -330,8 +335,9 @@ void add_kitti_raw_command(CLI::App& app) {
   command->add_option("--threads", o.threads, "worker threads (default: all cores)");
   command->add_option("--first", o.first, "first scan (index in velodyne_points/data)");
   command->add_option("--last", o.last, "last scan, included (default: the last)");
-  command->add_option("--initial-yaw-sigma-deg", o.initial_yaw_sigma_deg,
-                      "sigma of the initial heading (taken from the first packet), deg")
+  command
+      ->add_option("--initial-yaw-sigma-deg", o.initial_yaw_sigma_deg,
+                   "sigma of the initial heading (taken from the first packet), deg")
       ->check(CLI::Range(0.1, 360.0));
   command->add_option("--metrics-after", o.metrics_after, "seconds excluded from ATE and heading");
   command->add_option("--progress-seconds", o.progress_seconds,

@@ -45,14 +45,15 @@ std::vector<Eigen::Vector4f> cast_scan(const perception::SimWorld& world,
   const float deg = std::numbers::pi_v<float> / 180.0f;
   for (int b = 0; b < o.beams; ++b) {
     const float elevation =
-        (-24.8f + 26.8f * static_cast<float>(b) / static_cast<float>(std::max(o.beams - 1, 1))) * deg;
+        (-24.8f + 26.8f * static_cast<float>(b) / static_cast<float>(std::max(o.beams - 1, 1))) *
+        deg;
     for (int a = 0; a < o.azimuths; ++a) {
-      const float azimuth = 2.0f * std::numbers::pi_v<float> * static_cast<float>(a) /
-                            static_cast<float>(o.azimuths);
+      const float azimuth =
+          2.0f * std::numbers::pi_v<float> * static_cast<float>(a) / static_cast<float>(o.azimuths);
       const Eigen::Vector3f d(std::cos(elevation) * std::cos(azimuth),
                               std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
-      const auto hit = world.cast(world_from_velo.translation(), world_from_velo.linear() * d,
-                                  o.max_range);
+      const auto hit =
+          world.cast(world_from_velo.translation(), world_from_velo.linear() * d, o.max_range);
       if (!hit) continue;
       const Eigen::Vector3f p = d * hit->t;
       points.emplace_back(p.x(), p.y(), p.z(), 0.5f);
@@ -79,7 +80,8 @@ cv::Mat render_labels(const perception::SimWorld& world, const Eigen::Isometry3f
       const auto hit = world.cast(origin, world_from_rect.linear() * ray, 150.0f);
       const std::uint16_t c = hit ? perception::sim_map_class(hit->train_id) : perception::kNoLabel;
       const auto id = static_cast<std::uint8_t>(c == perception::kNoLabel ? 0 : c);
-      const cv::Rect block(u0, v0, std::min(stride, labels.cols - u0), std::min(stride, labels.rows - v0));
+      const cv::Rect block(u0, v0, std::min(stride, labels.cols - u0),
+                           std::min(stride, labels.rows - v0));
       labels(block).setTo(cv::Scalar(id));
     }
   }
@@ -101,7 +103,8 @@ perception::SimCamera kitti_colour_camera(const perception::KittiCameraCalibrati
 }
 
 void write_png(const fs::path& path, const cv::Mat& image) {
-  if (!cv::imwrite(path.string(), image)) throw std::runtime_error(path.string() + ": cannot write");
+  if (!cv::imwrite(path.string(), image))
+    throw std::runtime_error(path.string() + ": cannot write");
 }
 
 void write_text(const fs::path& path, const std::string& text) {
@@ -129,7 +132,8 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
   for (const char* sub : {"oxts/data", "velodyne_points/data", "labels_02", "image_02/data"}) {
     fs::create_directories(out.drive_dir / sub);
   }
-  for (const char* name : {"calib_cam_to_cam.txt", "calib_velo_to_cam.txt", "calib_imu_to_velo.txt"}) {
+  for (const char* name :
+       {"calib_cam_to_cam.txt", "calib_velo_to_cam.txt", "calib_imu_to_velo.txt"}) {
     fs::copy_file(kitti_calib / name, out.calib_dir / name, fs::copy_options::overwrite_existing);
   }
   const auto camera = perception::KittiCameraCalibration::load(
@@ -141,8 +145,7 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
   const Eigen::Isometry3d velo_from_rect =
       camera.cam_from_lidar.inverse() * Eigen::Isometry3d(camera.r_rect.transpose());
   // Camera 2's centre in the rectified frame of camera 0: -M^-1 p4 of P_rect_02 = [M | p4].
-  const Eigen::Vector3d cam2_centre =
-      -camera.p_rect.leftCols<3>().inverse() * camera.p_rect.col(3);
+  const Eigen::Vector3d cam2_centre = -camera.p_rect.leftCols<3>().inverse() * camera.p_rect.col(3);
   const perception::SimCamera colour = kitti_colour_camera(camera, o.seed);
 
   estimation::SimulatorConfig sc;
@@ -184,8 +187,7 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
     const auto points = cast_scan(world, street_from_velo.cast<float>(), o);
     map_io::write_kitti_scan(out.drive_dir / "velodyne_points/data" / frame_name(packet, ".bin"),
                              points);
-    scan_stamps << estimation::format_kitti_timestamp(
-                       common::Stamp(truth[at].stamp.ns + kEpochNs))
+    scan_stamps << estimation::format_kitti_timestamp(common::Stamp(truth[at].stamp.ns + kEpochNs))
                 << '\n';
     const Eigen::Isometry3d street_from_rect = street_from_velo * velo_from_rect;
     write_png(out.labels_dir / frame_name(packet, ".png"),
@@ -198,7 +200,8 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
     }
     ++out.scans;
   }
-  if (!oxts_stamps || !scan_stamps) throw std::runtime_error(out.drive_dir.string() + ": write failed");
+  if (!oxts_stamps || !scan_stamps)
+    throw std::runtime_error(out.drive_dir.string() + ": write failed");
   return out;
 }
 

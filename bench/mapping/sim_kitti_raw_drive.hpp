@@ -18,7 +18,7 @@ struct SimKittiRawOptions {
   int beams = 64;            // elevations from -24.8 to +2 degrees, as the HDL-64
   int azimuths = 1000;       // per revolution
   float max_range = 80.0f;
-  int label_stride = 4;      // the label image is cast every so many pixels (and upscaled)
+  int label_stride = 4;  // the label image is cast every so many pixels (and upscaled)
   // Also render image_02/data/*.png (the simulated colour camera, for --segmenter runs); about
   // 0.1 s per frame at KITTI's 1242 x 375.
   bool colour_images = false;
@@ -29,10 +29,10 @@ struct SimKittiRawOptions {
 
 // What the writer produced, for checks against the truth.
 struct SimKittiRawDrive {
-  std::filesystem::path calib_dir;  // <root>/2011_09_26 with the three calibration files
-  std::filesystem::path drive_dir;  // <calib_dir>/2011_09_26_drive_0001_sync
-  std::filesystem::path labels_dir;  // <drive_dir>/labels_02: 8-bit map class ids per scan
-  std::filesystem::path image_dir;   // <drive_dir>/image_02/data (with colour_images)
+  std::filesystem::path calib_dir;        // <root>/2011_09_26 with the three calibration files
+  std::filesystem::path drive_dir;        // <calib_dir>/2011_09_26_drive_0001_sync
+  std::filesystem::path labels_dir;       // <drive_dir>/labels_02: 8-bit map class ids per scan
+  std::filesystem::path image_dir;        // <drive_dir>/image_02/data (with colour_images)
   estimation::SimulationData simulation;  // the 100 Hz truth and IMU the packets came from
   std::vector<Eigen::Vector3d> path;      // world path of the street (ENU, metres)
   std::size_t scans = 0;

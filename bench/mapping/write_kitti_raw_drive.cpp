@@ -12,7 +12,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "usage: write_kitti_raw_drive ROOT KITTI_CALIB_DIR [SECONDS [AZIMUTHS [colour]]]\n"
                  "  writes ROOT/2011_09_26/2011_09_26_drive_0001_sync (10 scans per second after "
-                 "2 s at rest; labels in labels_02/; `colour`: also image_02/data/ from the simulated camera)\n");
+                 "2 s at rest; labels in labels_02/; `colour`: also image_02/data/ from the "
+                 "simulated camera)\n");
     return 2;
   }
   semap::bench::SimKittiRawOptions options;

@@ -57,13 +57,12 @@ EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
   return run;
 }
 
-std::vector<NamedEvaluationRun> run_filters(const SimulationData& data,
-                                            const EstimatorConfig& base,
+std::vector<NamedEvaluationRun> run_filters(const SimulationData& data, const EstimatorConfig& base,
                                             const EvaluationOptions& options,
                                             std::string_view choice) {
   if (choice != "inekf" && choice != "eskf" && choice != "both") {
-    throw std::invalid_argument("filter must be inekf, eskf or both, got '" +
-                                std::string(choice) + "'");
+    throw std::invalid_argument("filter must be inekf, eskf or both, got '" + std::string(choice) +
+                                "'");
   }
   std::vector<NamedEvaluationRun> runs;
   for (const FilterKind kind : {FilterKind::kLeftInekf, FilterKind::kQuaternionEskf}) {

@@ -37,10 +37,10 @@ std::string format_oxts_line(const OxtsRecord& r) {
                 "%.10f %.10f %.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g "
                 "%.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.6g %.6g 4 %d 5 5 6",
                 r.latitude_deg, r.longitude_deg, r.altitude_m, r.roll, r.pitch, r.yaw,
-                r.velocity_enu.y(), r.velocity_enu.x(), v_body.x(), v_body.y(),
-                r.velocity_enu.z(), r.accel.x(), r.accel.y(), r.accel.z(), r.accel.x(),
-                r.accel.y(), r.accel.z(), r.gyro.x(), r.gyro.y(), r.gyro.z(), r.gyro.x(),
-                r.gyro.y(), r.gyro.z(), r.position_accuracy_m, 0.02, r.satellites);
+                r.velocity_enu.y(), r.velocity_enu.x(), v_body.x(), v_body.y(), r.velocity_enu.z(),
+                r.accel.x(), r.accel.y(), r.accel.z(), r.accel.x(), r.accel.y(), r.accel.z(),
+                r.gyro.x(), r.gyro.y(), r.gyro.z(), r.gyro.x(), r.gyro.y(), r.gyro.z(),
+                r.position_accuracy_m, 0.02, r.satellites);
   return text;
 }
 

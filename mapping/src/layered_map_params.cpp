@@ -61,7 +61,6 @@ void validate(const LayeredMapParams& params) {
   }
 }
 
-
 LayeredMapParams layered_params(const MapParams& params) {
   LayeredMapParams p;
   p.method = params.method;

@@ -127,8 +127,8 @@ void odometry(FuzzInput& in) {
   twist.angular_ = {in.take<double>(), in.take<double>(), in.take<double>()};
   for (double& c : m.twist_.covariance_) c = in.take<double>();
   const PoseEstimate p = from_msg(m);
-  const std::int64_t ns = std::int64_t{m.header_.stamp_.sec_} * 1'000'000'000 +
-                          m.header_.stamp_.nanosec_;
+  const std::int64_t ns =
+      std::int64_t{m.header_.stamp_.sec_} * 1'000'000'000 + m.header_.stamp_.nanosec_;
   if (p.stamp.ns != ns) std::abort();
   const auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
   if (!same(p.position.x(), pose.position_.x_) || !same(p.position.z(), pose.position_.z_) ||

@@ -76,8 +76,8 @@ class CrcFixer {
   }
   bool put_crc(std::size_t from) {
     if (4 > b_.size() - at_) return false;
-    const auto crc = static_cast<std::uint32_t>(
-        ::crc32(0L, b_.data() + from, static_cast<uInt>(at_ - from)));
+    const auto crc =
+        static_cast<std::uint32_t>(::crc32(0L, b_.data() + from, static_cast<uInt>(at_ - from)));
     std::memcpy(b_.data() + at_, &crc, 4);
     at_ += 4;
     return true;

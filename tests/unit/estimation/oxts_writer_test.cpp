@@ -76,9 +76,8 @@ TEST(OxtsWriter, PacketAccuracyIsTheFixSigma) {
   const SimulationData sim = simulated_car(10.0);
   OxtsData data;
   for (std::size_t i = 0; i < 3; ++i) {
-    data.records.push_back(oxts_record_from_state(sim.truth[i].state, sim.imu[i],
-                                                  LocalEnu(sim.origin),
-                                                  0.5 * static_cast<double>(i)));
+    data.records.push_back(oxts_record_from_state(
+        sim.truth[i].state, sim.imu[i], LocalEnu(sim.origin), 0.5 * static_cast<double>(i)));
   }
   const SimulationData in = oxts_to_inputs(data, 7.0, 1, OxtsGnssNoise::kPacketAccuracy);
   EXPECT_DOUBLE_EQ(in.gnss[0].covariance(0, 0), kMinPacketSigmaM * kMinPacketSigmaM);

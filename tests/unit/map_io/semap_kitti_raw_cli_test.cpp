@@ -38,8 +38,8 @@ double figure(const std::string& out, const std::string& key) {
 }
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("semap_kitti_raw_" + name + "_" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("semap_kitti_raw_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -72,8 +72,9 @@ bench::SimKittiRawDrive* SemapKittiRawDrive::drive_ = nullptr;
 
 TEST_F(SemapKittiRawDrive, FilterBeatsGnssAndTheMapHoldsTheStreet) {
   const fs::path out = *root_ / "out";
-  const CliResult r = run(args_for(*drive_, out) +
-                          " --filter both --gnss-sigma 1.5 --threads 2 --progress-seconds 0.000001");
+  const CliResult r =
+      run(args_for(*drive_, out) +
+          " --filter both --gnss-sigma 1.5 --threads 2 --progress-seconds 0.000001");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(has(r.out, "white noise sigma 1.50 m per axis")) << r.out;
   // Raw fixes of sigma 1.5 per axis miss by about 1.5 sqrt(3) = 2.6 m; the filters must stay

@@ -195,8 +195,8 @@ TEST(KittiCameraCalibration, RealCalibrationPixels) {
   DropCounts drops;
   PointOptions options;
   options.max_range = 50.0f;
-  const auto cloud = label_lidar_points(points, make_segmentation(1242, 375, kClasses, false), calib,
-                                        Eigen::Isometry3f::Identity(), options, drops);
+  const auto cloud = label_lidar_points(points, make_segmentation(1242, 375, kClasses, false),
+                                        calib, Eigen::Isometry3f::Identity(), options, drops);
   EXPECT_EQ(cloud.size(), 3u);
   EXPECT_EQ(drops.out_of_image, 2u);
 }

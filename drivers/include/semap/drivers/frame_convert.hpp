@@ -20,8 +20,8 @@ inline constexpr std::uint32_t kMaxImageSide = 16384;
 // Converts a captured frame to an OpenCV image: YUYV and MJPEG to CV_8UC3 BGR, GREY to
 // CV_8UC1, Z16 to CV_16UC1 (depth units as the device reports them). Raw formats are copied
 // out of the frame; an empty Mat means the frame is truncated, its stride is shorter than a
-// row of pixels (or YUYV has an odd width, or Z16 an odd stride), a side exceeds kMaxImageSide, the JPEG is corrupt
-// or the JPEG's header gives another size than the frame's width and height.
+// row of pixels (or YUYV has an odd width, or Z16 an odd stride), a side exceeds kMaxImageSide, the
+// JPEG is corrupt or the JPEG's header gives another size than the frame's width and height.
 cv::Mat to_mat(const common::ImageFrame& frame, JpegDecoder& jpeg);
 
 // Bytes a complete raw frame needs (stride * height); 0 for compressed formats.

@@ -51,8 +51,7 @@ struct NamedEvaluationRun {
 
 // run_evaluation with `base` for each filter of an evaluation tool's --filter choice ("inekf",
 // "eskf" or "both", InEKF first). Throws std::invalid_argument for another choice.
-std::vector<NamedEvaluationRun> run_filters(const SimulationData& data,
-                                            const EstimatorConfig& base,
+std::vector<NamedEvaluationRun> run_filters(const SimulationData& data, const EstimatorConfig& base,
                                             const EvaluationOptions& options,
                                             std::string_view choice);
 
