@@ -219,9 +219,9 @@ int run(const semap::onboard::OnboardConfig& config, const RunOptions& options) 
   }
 
   // On hardware the camera is optional (an empty camera.device): without it the robot still
-  // estimates and publishes its pose, and its map stays empty. A segmenter or calibration that
-  // does not load leaves the robot in the same state, with the error logged: localisation must
-  // not depend on the camera half.
+  // estimates and publishes its pose, and its map stays empty. The configuration has read the
+  // model card, palette and calibration; a network OpenCV then fails to load leaves the robot in
+  // the same state, with the error logged: localisation must not depend on the camera half.
   const bool camera = rig || (replay ? replay->has_camera() : !config.camera.driver.device.empty());
   std::unique_ptr<onboard::PerceptionStage> perception_stage;
   if (camera) {
@@ -531,8 +531,11 @@ int run(const semap::onboard::OnboardConfig& config, const RunOptions& options) 
     const auto summary = report->write(figures, mapping_stage.map(), est);
     std::printf("report           : %s\n", summary.c_str());
   }
-  // Without a camera an empty map is expected; a filter that never initialised is a failure
-  // either way.
+  // Stopped by a signal (systemctl stop, Ctrl-C), the run ended as asked: the map is saved, and
+  // a service stopped before its filter initialised or its camera mapped has not failed. A run
+  // that ended by itself fails when the filter never initialised, or when it had a camera and
+  // mapped nothing.
+  if (g_stop.load()) return 0;
   const bool mapped = !camera || map.scans > 0;
   return est.initialised && mapped ? 0 : 1;
 }

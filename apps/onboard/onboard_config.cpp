@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "segmenter_factory.hpp"
 #include "semap/common/config.hpp"
 #include "semap/drivers/driver_config.hpp"
 
@@ -139,6 +140,11 @@ void read_depth(const ConfigSection& s, const CameraConfig& camera, DepthConfig&
         s.get_in_range("sync_tolerance_ms", 1e3 * depth.sync_tolerance_s, 0.0, 1000.0) / 1e3;
   } else {
     depth.stereo_calibration = std::filesystem::absolute(s.get<std::string>("calibration"));
+    try {
+      load_stereo_calibration(depth.stereo_calibration);
+    } catch (const std::exception& e) {
+      s.reject("calibration", e.what());
+    }
     depth.stereo.num_disparities =
         static_cast<int>(s.get_in_range("num_disparities", depth.stereo.num_disparities, 16, 512));
     if (depth.stereo.num_disparities % 16 != 0) {
@@ -232,6 +238,14 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path) {
   c.map.start_heading_sigma_deg =
       map.get_in_range("start_heading_sigma_deg", c.map.start_heading_sigma_deg, 0.01, 180.0);
   map.finish();
+  // Read now: a wrong model path must stop start-up, not leave the robot running without a map.
+  try {
+    check_segmenter_files(c.segmenter, c.map.params.num_classes);
+  } catch (const std::exception& e) {
+    const auto segmenter = root.section_or_empty("segmenter");
+    segmenter.reject(c.segmenter.kind == SegmenterConfig::Kind::kOnnx ? "model_card" : "palette",
+                     e.what());
+  }
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);
   if (root.has("costmap")) {

@@ -18,4 +18,9 @@ Eigen::Isometry3f CameraConfig::body_from_optical() const {
   return t;
 }
 
+perception::StereoCalibration load_stereo_calibration(const std::filesystem::path& file) {
+  return file.extension() == ".txt" ? perception::StereoCalibration::load_kitti(file)
+                                    : perception::StereoCalibration::from_opencv_yaml(file);
+}
+
 }  // namespace semap::onboard

@@ -42,6 +42,9 @@ struct DepthConfig {
   std::size_t ring = 4;
 };
 
+// KITTI's calib_cam_to_cam.txt (.txt) or an OpenCV FileStorage file (anything else).
+perception::StereoCalibration load_stereo_calibration(const std::filesystem::path& file);
+
 // segmenter: what labels the pixels.
 struct SegmenterConfig {
   enum class Kind { kOnnx, kPalette } kind = Kind::kPalette;

@@ -50,12 +50,8 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
     throw std::invalid_argument("perception stage: aligned depth needs a depth frame ring");
   }
   if (depth_.source == DepthSource::kStereo) {
-    // KITTI's calib_cam_to_cam.txt is text; anything else is an OpenCV FileStorage file.
-    const auto& file = depth_.stereo_calibration;
     stereo_ = std::make_unique<perception::StereoDepth>(
-        file.extension() == ".txt" ? perception::StereoCalibration::load_kitti(file)
-                                   : perception::StereoCalibration::from_opencv_yaml(file),
-        depth_.stereo);
+        load_stereo_calibration(depth_.stereo_calibration), depth_.stereo);
   }
 }
 

@@ -13,4 +13,8 @@ namespace semap::onboard {
 std::unique_ptr<perception::Segmenter> make_segmenter(const SegmenterConfig& config,
                                                       int map_classes);
 
+// Reads what make_segmenter would read (the model card, or the palette) and checks it against
+// the map, without loading a network: the configuration's check at start-up.
+void check_segmenter_files(const SegmenterConfig& config, int map_classes);
+
 }  // namespace semap::onboard

@@ -11,7 +11,7 @@
 namespace semap::drivers {
 
 CameraDriver::CameraDriver(CameraConfig config, common::SpscRing<common::ImageFrame>& ring)
-    : DriverRunner("camera", config.backoff),
+    : DriverRunner("camera", config.backoff, config.realtime_priority),
       config_(std::move(config)),
       ring_(ring),
       jpeg_(std::make_unique<JpegDecoder>()) {}

@@ -11,7 +11,7 @@ constexpr std::chrono::milliseconds kStatePollInterval{250};
 }  // namespace
 
 CanImuDriver::CanImuDriver(CanImuConfig config, common::SpscRing<common::ImuSample>& ring)
-    : DriverRunner("can_imu", config.backoff),
+    : DriverRunner("can_imu", config.backoff, config.realtime_priority),
       config_(std::move(config)),
       ring_(ring),
       decoder_(config_.decoder),

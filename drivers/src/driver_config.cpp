@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "semap/drivers/realtime.hpp"
+
 namespace semap::drivers {
 namespace {
 
@@ -37,6 +39,7 @@ CanImuConfig can_imu_config(const common::ConfigSection& imu) {
   c.fd_frames = imu.get<bool>("fd_frames", c.fd_frames);
   c.restart_bus_off = imu.get<bool>("restart_bus_off", c.restart_bus_off);
   c.backoff = backoff(imu);
+  c.realtime_priority = get_int(imu, "realtime_priority", 0, 0, kMaxRealtimePriority);
   return c;
 }
 
@@ -56,6 +59,7 @@ GnssConfig gnss_config(const common::ConfigSection& gnss) {
   c.serial.vtime = get_int(gnss, "vtime", c.serial.vtime, 0, 255);
   c.fix.uere_m = gnss.get_in_range("uere_m", c.fix.uere_m, 0.01, 100.0);
   c.backoff = backoff(gnss);
+  c.realtime_priority = get_int(gnss, "realtime_priority", 0, 0, kMaxRealtimePriority);
   return c;
 }
 
@@ -72,6 +76,7 @@ CameraConfig camera_config(const common::ConfigSection& camera) {
   c.fps = camera.get_in_range("fps", c.fps, 0.1, 1000.0);
   c.buffers = static_cast<std::uint32_t>(get_int(camera, "buffers", 4, 2, 32));
   c.backoff = backoff(camera);
+  c.realtime_priority = get_int(camera, "realtime_priority", 0, 0, kMaxRealtimePriority);
   return c;
 }
 

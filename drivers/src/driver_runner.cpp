@@ -2,8 +2,10 @@
 
 #include <condition_variable>
 #include <exception>
+#include <stdexcept>
 
 #include "semap/common/logging.hpp"
+#include "semap/drivers/realtime.hpp"
 
 namespace semap::drivers {
 namespace {
@@ -32,9 +34,16 @@ const char* to_string(DriverState state) {
   return "unknown";
 }
 
-DriverRunner::DriverRunner(std::string name, BackoffConfig backoff)
-    : name_(std::move(name)), backoff_config_(backoff), log_(common::logger(name_)) {
+DriverRunner::DriverRunner(std::string name, BackoffConfig backoff, int realtime_priority)
+    : name_(std::move(name)),
+      backoff_config_(backoff),
+      realtime_priority_(realtime_priority),
+      log_(common::logger(name_)) {
   Backoff check(backoff);  // validates the configuration before any thread starts
+  if (realtime_priority < 0 || realtime_priority > kMaxRealtimePriority) {
+    throw std::invalid_argument(name_ + ": realtime priority " + std::to_string(realtime_priority) +
+                                " is outside 0..99");
+  }
 }
 
 DriverRunner::~DriverRunner() { stop(); }
@@ -70,6 +79,15 @@ void DriverRunner::report(const std::string& message, bool lost) {
 }
 
 void DriverRunner::run(std::stop_token stop) {
+  if (realtime_priority_ > 0) {
+    const std::string refused = set_realtime_priority(realtime_priority_);
+    if (refused.empty()) {
+      realtime_applied_.store(realtime_priority_, std::memory_order_release);
+      log_->info("thread at SCHED_FIFO priority {}", realtime_priority_);
+    } else {
+      report(refused + "; running at normal scheduling", false);
+    }
+  }
   Backoff backoff(backoff_config_);
   bool ever_connected = false;
   while (!stop.stop_requested()) {

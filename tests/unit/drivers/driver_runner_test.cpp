@@ -4,9 +4,12 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <pthread.h>
+#include <sched.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +17,7 @@
 #include <thread>
 
 #include "semap/drivers/driver_error.hpp"
+#include "semap/drivers/realtime.hpp"
 
 namespace semap::drivers {
 namespace {
@@ -139,6 +143,61 @@ TEST_F(DriverRunnerTest, StopIsPromptDuringALongBackoff) {
   driver.stop();
   EXPECT_LT(std::chrono::steady_clock::now() - t0, 1s);
   EXPECT_EQ(driver.state(), DriverState::kStopped);
+}
+
+// Records the scheduling its thread runs with.
+class SchedulingDriver : public DriverRunner {
+ public:
+  explicit SchedulingDriver(int realtime_priority)
+      : DriverRunner("scheduling_driver", {}, realtime_priority) {}
+  ~SchedulingDriver() override { stop(); }
+
+  std::atomic<int> policy{-1};
+  std::atomic<int> priority{-1};
+
+ protected:
+  void open_device() override {}
+  void service_device(std::stop_token) override {
+    int p = 0;
+    sched_param param{};
+    ::pthread_getschedparam(::pthread_self(), &p, &param);
+    priority.store(param.sched_priority);
+    policy.store(p);
+    std::this_thread::sleep_for(1ms);
+  }
+  void close_device() noexcept override {}
+};
+
+TEST(DriverRealtime, ThreadRunsAtTheRequestedFifoPriorityOrSaysWhyNot) {
+  SchedulingDriver driver(7);
+  driver.start();
+  ASSERT_TRUE(wait_until([&] { return driver.policy.load() >= 0; }, 5s));
+  if (driver.realtime_priority() == 7) {
+    EXPECT_EQ(driver.policy.load(), SCHED_FIFO);
+    EXPECT_EQ(driver.priority.load(), 7);
+    EXPECT_EQ(driver.last_error(), "");
+  } else {
+    // Without CAP_SYS_NICE or an RLIMIT_RTPRIO of 7 the kernel refuses; the driver runs on.
+    EXPECT_EQ(driver.realtime_priority(), 0);
+    EXPECT_EQ(driver.policy.load(), SCHED_OTHER);
+    EXPECT_NE(driver.last_error().find("SCHED_FIFO priority 7 refused"), std::string::npos)
+        << driver.last_error();
+    EXPECT_EQ(driver.state(), DriverState::kRunning);
+  }
+}
+
+TEST(DriverRealtime, NormalSchedulingUnlessAsked) {
+  SchedulingDriver driver(0);
+  driver.start();
+  ASSERT_TRUE(wait_until([&] { return driver.policy.load() >= 0; }, 5s));
+  EXPECT_EQ(driver.policy.load(), SCHED_OTHER);
+  EXPECT_EQ(driver.realtime_priority(), 0);
+}
+
+TEST(DriverRealtime, RefusalsNameThePriorityAndTheReason) {
+  EXPECT_EQ(set_realtime_priority(100), "SCHED_FIFO priority 100 refused: Invalid argument");
+  EXPECT_THROW(SchedulingDriver(100), std::invalid_argument);
+  EXPECT_THROW(SchedulingDriver(-1), std::invalid_argument);
 }
 
 }  // namespace

@@ -177,6 +177,10 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
       {"  lever_arm: [0, 0, 0]", "  lever_arm: [0, 0]", "gnss.lever_arm", "expected 3 numbers"},
       {"  profile: semap", "  profile: j1939\n  j1939_source: 254", "imu.j1939_source", "254"},
       {"  ring: 4096", "  ring: 8", "imu.ring", "out of range"},
+      {"  ring: 4096", "  ring: 4096\n  realtime_priority: 100", "imu.realtime_priority",
+       "out of range"},
+      {"  baud: 115200", "  baud: 115200\n  realtime_priority: 2.5", "gnss.realtime_priority",
+       "must be an integer"},
       {"  kind: sim", "  kind: bag", "rig.kind", "bag"},
       {"  kind: sim", "  kind: replay", "rig.replay", "needs the recording's directory"},
       {"  kind: sim", "  kind: replay\n  replay: /nonexistent/run", "rig.replay",
@@ -196,6 +200,17 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
       {"  domain: 0", "  domain: 300", "dds.domain", "out of range"},
       {"  publish_hz: 2\n  cloud_hz", "  publish_hz: 0\n  cloud_hz", "dds.publish_hz",
        "out of range"},
+      {"  model_card: models/semap-seg.yaml", "  model_card: models/missing.yaml",
+       "segmenter.model_card", "models/missing.yaml"},
+      {"  model_card: models/semap-seg.yaml", "  model_card: config/sim.yaml",
+       "segmenter.model_card", "sim.yaml"},
+      {"  kind: onnx                 # the network trained on the street world "
+       "(scripts/train-segmenter)\n  model_card: models/semap-seg.yaml",
+       "  kind: palette\n  palette: config/missing-palette.yaml", "segmenter.palette",
+       "missing-palette.yaml"},
+      {"  source: aligned\n  depth_scale: 0.001",
+       "  source: stereo\n  calibration: config/missing-calibration.yaml", "depth.calibration",
+       "missing-calibration.yaml"},
   };
   for (const Case& c : cases) {
     const auto path = edited_sim(c.replace, c.with);

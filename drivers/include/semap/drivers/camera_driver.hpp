@@ -28,6 +28,7 @@ struct CameraConfig {
   // No frame for this long while streaming counts as a lost device (reopen).
   std::chrono::milliseconds stall_timeout{2000};
   BackoffConfig backoff;
+  int realtime_priority = 0;  // SCHED_FIFO 1..99 for the driver's thread; 0: normal
 };
 
 // What the device agreed to; valid once state() is kRunning.

@@ -27,6 +27,7 @@ struct CanImuConfig {
   // own; paced by `backoff`. False leaves recovery to the system.
   bool restart_bus_off = true;
   BackoffConfig backoff;
+  int realtime_priority = 0;  // SCHED_FIFO 1..99 for the driver's thread; 0: normal
 };
 
 // SocketCAN IMU thread: a CAN_RAW socket with kernel filters for the profile's identifiers,

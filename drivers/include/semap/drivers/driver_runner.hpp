@@ -28,10 +28,11 @@ const char* to_string(DriverState state);
 //   open -> service until it throws -> report, close, wait (backoff) -> open ...
 // on its own thread until stop(). service_device() must return within a bounded time (it polls
 // with a timeout) so that stop() is prompt. Derived destructors must call stop() first, since
-// the thread calls their virtual functions.
+// the thread calls their virtual functions. With a realtime priority the thread runs at
+// SCHED_FIFO (realtime.hpp); a refusal is reported and the thread runs on at normal scheduling.
 class DriverRunner {
  public:
-  DriverRunner(std::string name, BackoffConfig backoff);
+  DriverRunner(std::string name, BackoffConfig backoff, int realtime_priority = 0);
   virtual ~DriverRunner();
   DriverRunner(const DriverRunner&) = delete;
   DriverRunner& operator=(const DriverRunner&) = delete;
@@ -46,6 +47,8 @@ class DriverRunner {
   // not overwrite; empty while the device has never been lost.
   std::string last_loss() const;
   const std::string& name() const { return name_; }
+  // The SCHED_FIFO priority the thread runs at; 0 when not asked for or refused.
+  int realtime_priority() const { return realtime_applied_.load(std::memory_order_acquire); }
   // Number of failures reported (open failures and lost devices), for health reporting.
   std::uint64_t failures() const { return failures_.load(std::memory_order_acquire); }
 
@@ -74,6 +77,8 @@ class DriverRunner {
 
   std::string name_;
   BackoffConfig backoff_config_;
+  int realtime_priority_;
+  std::atomic<int> realtime_applied_{0};
   std::shared_ptr<spdlog::logger> log_;
   DriverCounters counters_;
   std::atomic<DriverState> state_{DriverState::kStopped};

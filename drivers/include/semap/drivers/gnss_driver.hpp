@@ -18,6 +18,7 @@ struct GnssConfig {
   firmware_bridge::GnssFixBuilderConfig fix;
   int poll_timeout_ms = 100;
   BackoffConfig backoff;
+  int realtime_priority = 0;  // SCHED_FIFO 1..99 for the driver's thread; 0: normal
 };
 
 // Serial GNSS thread: termios raw 8N1, poll()-based reads, NMEA and UBX (interleaved) through
