@@ -24,6 +24,8 @@
 #include "onboard_config.hpp"
 #include "perception_stage.hpp"
 #include "replay_rig.hpp"
+#include "run_figures.hpp"
+#include "run_summary.hpp"
 #include "segmenter_factory.hpp"
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
@@ -52,109 +54,11 @@ void on_signal(int) { g_stop.store(true); }
 
 using semap::common::OverflowPolicy;
 using semap::common::SpscRing;
-
-// Position error of the live estimate against the rig's truth, in the simulator's frame.
-class LiveAccuracy {
- public:
-  void sample(const semap::onboard::SimRig& rig, const semap::onboard::EstimationStageStats& s) {
-    const auto pose = semap::onboard::pose_vs_truth(rig, s);
-    if (!pose) return;
-    if (!first_) first_ = pose->stamp;
-    if (semap::common::seconds_between(pose->stamp, *first_) < 10.0) return;  // settling
-    const double e2 = (pose->estimate - pose->truth).squaredNorm();
-    sum_sq_ += e2;
-    max_ = std::max(max_, std::sqrt(e2));
-    ++count_;
-  }
-  bool any() const { return count_ > 0; }
-  double rmse() const { return std::sqrt(sum_sq_ / static_cast<double>(count_)); }
-  double max() const { return max_; }
-  std::size_t count() const { return count_; }
-
- private:
-  std::optional<semap::common::Stamp> first_;
-  double sum_sq_ = 0.0;
-  double max_ = 0.0;
-  std::size_t count_ = 0;
-};
-
-// Rings feeding each stage, for the health report.
-struct Rings {
-  SpscRing<semap::common::ImuSample>& imu;
-  SpscRing<semap::common::GnssFix>& gnss;
-  SpscRing<semap::common::ImageFrame>& colour;
-  SpscRing<semap::common::ImageFrame>& depth;
-  SpscRing<semap::common::LabeledCloud>& clouds;
-};
-
-template <typename... R>
-std::uint32_t depth(const R&... rings) {
-  return static_cast<std::uint32_t>((rings.size() + ...));
-}
-template <typename... R>
-std::uint64_t drops(const R&... rings) {
-  return (rings.counters().drops() + ...);
-}
-
-std::vector<semap::onboard::StageFigures> stage_figures(
-    const Rings& r, const semap::onboard::EstimationStage& estimation,
-    const semap::onboard::PerceptionStage* perception, const semap::onboard::MappingStage& mapping,
-    const semap::onboard::DdsOutputs& dds) {
-  const auto est = estimation.stats();
-  const auto map = mapping.stats();
-  const auto out = dds.map_counters();
-  std::vector<semap::onboard::StageFigures> figures{
-      {"estimation", est.imu_samples, depth(r.imu, r.gnss), drops(r.imu, r.gnss),
-       estimation.imu_latency().percentiles()},
-      {"mapping", map.scans, depth(r.clouds), drops(r.clouds), mapping.latency().percentiles()},
-      // Blocks written, blocks waiting for the next round; a "drop" is a round cut short by a
-      // slow reader (its blocks stay pending, nothing is lost).
-      {"dds_map",
-       out.blocks_written,
-       static_cast<std::uint32_t>(dds.map_pending()),
-       out.write_timeouts,
-       {}},
-  };
-  if (perception) {
-    // Colour frames lost anywhere before the map: in the driver's ring, passed over,
-    // unpaired, unreadable or without a pose.
-    const auto p = perception->stats();
-    figures.push_back({"perception", p.clouds, perception->queue_depth(),
-                       drops(r.colour) + p.skipped + p.unpaired + p.bad_frames + p.without_pose,
-                       perception->latency().percentiles()});
-  }
-  return figures;
-}
-
-// Rates over the last interval, ring depths and drops: the progress line every few seconds.
-class Progress {
- public:
-  std::string line(double t, const semap::onboard::EstimationStageStats& est,
-                   const semap::onboard::PerceptionStageStats& perception,
-                   const semap::onboard::MappingStageStats& map, const Rings& r) {
-    const double dt = t - last_t_;
-    const auto rate = [&](std::uint64_t now, std::uint64_t& before) {
-      const double hz = dt > 0 ? static_cast<double>(now - before) / dt : 0.0;
-      before = now;
-      return hz;
-    };
-    const double imu = rate(est.imu_samples, imu_), gnss = rate(est.gnss_fixes, gnss_),
-                 frames = rate(perception.frames, frames_),
-                 clouds = rate(perception.clouds, clouds_), scans = rate(map.scans, scans_);
-    last_t_ = t;
-    return fmt::format(
-        "t={:.0f}s init={} | Hz imu {:.0f} gnss {:.1f} frames {:.1f} clouds {:.1f} scans {:.1f} | "
-        "blocks {} | rings imu/gnss/colour/depth/clouds: queued {}/{}/{}/{}/{} dropped "
-        "{}/{}/{}/{}/{}",
-        t, est.initialised ? "yes" : "no", imu, gnss, frames, clouds, scans, map.map.blocks,
-        r.imu.size(), r.gnss.size(), r.colour.size(), r.depth.size(), r.clouds.size(), drops(r.imu),
-        drops(r.gnss), drops(r.colour), drops(r.depth), drops(r.clouds));
-  }
-
- private:
-  double last_t_ = 0.0;
-  std::uint64_t imu_ = 0, gnss_ = 0, frames_ = 0, clouds_ = 0, scans_ = 0;
-};
+using semap::onboard::drops;
+using semap::onboard::LiveAccuracy;
+using semap::onboard::Progress;
+using semap::onboard::Rings;
+using semap::onboard::stage_figures;
 
 // What the command line adds to the configuration.
 struct RunOptions {
@@ -412,102 +316,19 @@ int run(const semap::onboard::OnboardConfig& config, const RunOptions& options) 
     mapping::write_smap(path, mapping_stage.map().layers());
     log->info("map saved to {}", path.string());
   }
-  std::printf("\n== semap-onboard summary ==\n");
-  if (gnss_driver) {
-    const auto g = gnss_driver->stats();
-    std::printf("gnss driver      : %lu fixes, %lu bytes, %lu checksum failures, %lu reconnects\n",
-                g.frames, g.bytes, g.checksum_failures, g.reconnects);
-  }
-  if (imu_driver) {
-    const auto i = imu_driver->stats();
-    std::printf(
-        "imu driver       : %lu samples, %lu CRC failures, %lu gaps, %lu reconnects, %lu bus-off "
-        "(%lu restarts), %lu error-passive\n",
-        i.frames, i.checksum_failures, i.sequence_gaps, i.reconnects, i.bus_off, i.bus_restarts,
-        i.error_passive);
-  }
-  std::printf(
-      "estimation       : %lu IMU samples, %lu GNSS fixes (%lu applied, %lu gated out), "
-      "initialised=%s\n",
-      est.imu_samples, est.gnss_fixes, est.estimator.gnss_applied, est.estimator.gnss_rejected,
-      est.initialised ? "yes" : "no");
-  if (accuracy.any()) {
-    std::printf("pose vs truth    : position RMSE %.3f m, max %.3f m over %zu checks\n",
-                accuracy.rmse(), accuracy.max(), accuracy.count());
-  }
-  if (camera_driver) {
-    const auto c = camera_driver->stats();
-    std::printf("camera driver    : %lu frames, %lu bad, %lu reconnects\n", c.frames,
-                c.checksum_failures, c.reconnects);
-  }
-  if (perception_stage) {
-    const auto p = perception_stage->stats();
-    const auto lat = perception_stage->latency().percentiles();
-    std::printf(
-        "perception       : %lu frames, %lu clouds mapped (%lu points), %lu passed over, "
-        "%lu unpaired, %lu bad, %lu without a pose; segment mean %.1f ms max %.1f ms; "
-        "latency p50 %.1f ms p99 %.1f ms\n",
-        p.frames, p.clouds, p.points, p.skipped, p.unpaired, p.bad_frames, p.without_pose,
-        p.clouds ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
-        1e3 * p.segment_seconds_max, static_cast<double>(lat.p50_ms),
-        static_cast<double>(lat.p99_ms));
-    std::printf(
-        "pixels dropped   : %lu no depth, %lu out of range, %lu no label, %lu low confidence\n",
-        p.dropped.no_depth, p.dropped.out_of_range, p.dropped.no_label, p.dropped.low_confidence);
-  }
-  std::printf(
-      "mapping          : %lu scans, %lu points, insert mean %.1f ms max %.1f ms, "
-      "%zu blocks, %zu observed cells, %.1f bytes/cell\n",
-      map.scans, map.points,
-      map.scans ? 1e3 * map.insert_seconds_total / static_cast<double>(map.scans) : 0.0,
-      1e3 * map.insert_seconds_max, map.map.blocks, map.map.observed_cells,
-      map.map.bytes_per_cell());
-  if (map.checkpoint.checkpoints > 0 || map.checkpoint.resumed_scans > 0) {
-    std::printf(
-        "map checkpoint   : %s, %lu checkpoints, %lu blocks written, write max %.1f ms, "
-        "%.1f MB, resumed %lu blocks of %lu scans\n",
-        checkpoint_path.c_str(), map.checkpoint.checkpoints, map.checkpoint.blocks_written,
-        1e3 * map.checkpoint.max_write_s, static_cast<double>(map.checkpoint.log_bytes) / 1e6,
-        map.checkpoint.resumed_blocks, map.checkpoint.resumed_scans);
-  }
-  if (config.map.memory_radius_m > 0.0) {
-    std::printf("map paging       : radius %.0f m, %lu blocks paged out, %lu paged in\n",
-                config.map.memory_radius_m, map.pager.evicted, map.pager.restored);
-  }
-  if (dds) {
-    const auto m = dds->map_counters();
-    std::printf(
-        "dds              : %lu odometry samples, %lu block samples in %lu rounds, "
-        "%lu map clouds, %lu cloud updates (%lu points), %lu health reports\n",
-        dds->odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
-        m.cloud_updates_written, m.cloud_update_points, dds->health_written());
-    if (const auto c = dds->costmap_counters()) {
-      std::printf(
-          "costmap          : %lu grids (%lu rebuilt around the robot), %lu updates, last round "
-          "%.1f ms\n",
-          c->grids_written, c->rebuilds, c->updates_written, 1e3 * c->last_seconds);
-    }
-  }
-  if (recorder) {
-    const auto r = recorder->counters();
-    std::printf(
-        "recording        : %s: %lu CAN frames, %lu GNSS reads (%lu bytes), %lu colour and %lu "
-        "depth frames, %.1f MB, %lu write failures\n",
-        recorder->dir().c_str(), r.can_frames, r.gnss_reads, r.gnss_bytes, r.colour_frames,
-        r.depth_frames, static_cast<double>(r.bytes) / 1e6, r.write_failures);
-  }
-  if (replay) {
-    const auto r = replay->counters();
-    const std::string damage = replay->error();
-    std::printf(
-        "replay           : %lu CAN frames (%lu error frames), %lu IMU samples, %lu GNSS reads, "
-        "%lu colour and %lu depth frames%s%s\n",
-        r.can_frames, r.can_error_frames, r.imu_samples, r.gnss_reads, r.colour_frames,
-        r.depth_frames, damage.empty() ? "" : "; damaged: ", damage.c_str());
-  }
-  std::printf("ring drops       : imu %lu, gnss %lu, colour %lu, depth %lu, clouds %lu\n",
-              drops(imu_ring), drops(gnss_ring), drops(colour_ring), drops(depth_ring),
-              drops(cloud_ring));
+  onboard::print_summary({.gnss_driver = gnss_driver.get(),
+                          .imu_driver = imu_driver.get(),
+                          .camera_driver = camera_driver.get(),
+                          .estimation = est,
+                          .accuracy = &accuracy,
+                          .perception = perception_stage.get(),
+                          .map = map,
+                          .checkpoint_path = checkpoint_path,
+                          .memory_radius_m = config.map.memory_radius_m,
+                          .dds = dds.get(),
+                          .recorder = recorder.get(),
+                          .replay = replay.get(),
+                          .rings = rings});
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   const double cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
