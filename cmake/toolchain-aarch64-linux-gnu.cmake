@@ -27,8 +27,10 @@ set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 
+# Some arm64 packages install their libraries in /usr/lib (GDAL's armadillo, HDF4, OGDI).
 set(semap_arm64_libdirs
-    ${SEMAP_SYSROOT}/usr/lib/aarch64-linux-gnu ${SEMAP_SYSROOT}/lib/aarch64-linux-gnu)
+    ${SEMAP_SYSROOT}/usr/lib/aarch64-linux-gnu ${SEMAP_SYSROOT}/lib/aarch64-linux-gnu
+    ${SEMAP_SYSROOT}/usr/lib)
 # No --sysroot (libc is not in it): the packages' CMake configs point their targets at the
 # sysroot's headers and libraries.
 # Shared libraries pull in others (spdlog -> fmt): let the linker find those in the sysroot.
