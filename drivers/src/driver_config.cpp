@@ -22,6 +22,10 @@ BackoffConfig backoff(const common::ConfigSection& s) {
   return b;
 }
 
+int realtime_priority(const common::ConfigSection& s) {
+  return get_int(s, "realtime_priority", 0, 0, kMaxRealtimePriority);
+}
+
 }  // namespace
 
 CanImuConfig can_imu_config(const common::ConfigSection& imu) {
@@ -39,7 +43,7 @@ CanImuConfig can_imu_config(const common::ConfigSection& imu) {
   c.fd_frames = imu.get<bool>("fd_frames", c.fd_frames);
   c.restart_bus_off = imu.get<bool>("restart_bus_off", c.restart_bus_off);
   c.backoff = backoff(imu);
-  c.realtime_priority = get_int(imu, "realtime_priority", 0, 0, kMaxRealtimePriority);
+  c.realtime_priority = realtime_priority(imu);
   return c;
 }
 
@@ -59,7 +63,7 @@ GnssConfig gnss_config(const common::ConfigSection& gnss) {
   c.serial.vtime = get_int(gnss, "vtime", c.serial.vtime, 0, 255);
   c.fix.uere_m = gnss.get_in_range("uere_m", c.fix.uere_m, 0.01, 100.0);
   c.backoff = backoff(gnss);
-  c.realtime_priority = get_int(gnss, "realtime_priority", 0, 0, kMaxRealtimePriority);
+  c.realtime_priority = realtime_priority(gnss);
   return c;
 }
 
@@ -76,7 +80,7 @@ CameraConfig camera_config(const common::ConfigSection& camera) {
   c.fps = camera.get_in_range("fps", c.fps, 0.1, 1000.0);
   c.buffers = static_cast<std::uint32_t>(get_int(camera, "buffers", 4, 2, 32));
   c.backoff = backoff(camera);
-  c.realtime_priority = get_int(camera, "realtime_priority", 0, 0, kMaxRealtimePriority);
+  c.realtime_priority = realtime_priority(camera);
   return c;
 }
 
