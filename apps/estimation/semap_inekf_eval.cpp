@@ -12,7 +12,7 @@
 #include "semap/estimation/estimator_config.hpp"
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/oxts_reader.hpp"
-#include "semap/estimation/simulator.hpp"
+#include "semap/sim/drive_simulator.hpp"
 #include "semap/estimation/so3.hpp"
 #include "top_view.hpp"
 
@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
       const auto root = semap::common::ConfigSection::load_file(config_path);
       base = est::load_estimator_config(root.section("estimator"));
     }
-    est::SimulationData data;
+    est::DriveData data;
     est::EvaluationOptions options;
     options.metrics_after_s = metrics_after;
     if (!oxts_dir.empty()) {

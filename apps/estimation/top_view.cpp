@@ -20,7 +20,7 @@ const std::array<cv::Scalar, 3> kColours = {cv::Scalar(200, 80, 0), cv::Scalar(0
                                             cv::Scalar(0, 160, 220)};
 }  // namespace
 
-void write_top_view(const std::filesystem::path& path, const estimation::SimulationData& data,
+void write_top_view(const std::filesystem::path& path, const estimation::DriveData& data,
                     const std::vector<estimation::NamedEvaluationRun>& runs,
                     const std::string& truth_label) {
   const estimation::LocalEnu enu(data.origin);

@@ -10,7 +10,7 @@ namespace semap::apps {
 
 // Top view (east right, north up) of the truth (named `truth_label` in the legend), each
 // estimate and the GNSS fixes, as PNG.
-void write_top_view(const std::filesystem::path& path, const estimation::SimulationData& data,
+void write_top_view(const std::filesystem::path& path, const estimation::DriveData& data,
                     const std::vector<estimation::NamedEvaluationRun>& runs,
                     const std::string& truth_label = "truth");
 

@@ -18,8 +18,8 @@
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/drivers/serial_port.hpp"
-#include "semap/firmware_bridge/constant_turn_source.hpp"
-#include "semap/firmware_bridge/emulator.hpp"
+#include "semap/sim/constant_turn_source.hpp"
+#include "semap/sim/emulator.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
 
 namespace {

@@ -82,7 +82,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 // RMSE of the raw fixes against the OXTS positions: what the filters have to beat.
-double gnss_ate(const est::SimulationData& data) {
+double gnss_ate(const est::DriveData& data) {
   const est::LocalEnu enu(data.origin);
   std::vector<est::Pose3> fixes;
   std::vector<est::Pose3> truth;
@@ -213,7 +213,7 @@ int run(const CLI::App& command, const RawOptions& o) {
   }
   const bool packet = o.gnss_sigma == "packet";
   const double sigma = packet ? 0.0 : std::stod(o.gnss_sigma);
-  const est::SimulationData data = est::oxts_to_inputs(
+  const est::DriveData data = est::oxts_to_inputs(
       oxts, sigma, o.seed,
       packet ? est::OxtsGnssNoise::kPacketAccuracy : est::OxtsGnssNoise::kFixedSigma);
 

@@ -11,11 +11,11 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "semap/estimation/simulator.hpp"
+#include "semap/sim/drive_simulator.hpp"
 #include "semap/perception/palette_segmenter.hpp"
-#include "semap/perception/sim_camera.hpp"
+#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
-#include "semap/perception/sim_world.hpp"
+#include "semap/sim/world.hpp"
 
 namespace {
 
@@ -46,15 +46,15 @@ struct Settings {
   int height = 240;
 };
 
-estimation::SimulationData drive(int seed) {
-  estimation::SimulatorConfig sim;
-  sim.scenario = seed % 2 == 0 ? estimation::Scenario::kFigureEight : estimation::Scenario::kCar;
+estimation::DriveData drive(int seed) {
+  sim::SimulatorConfig sim;
+  sim.scenario = seed % 2 == 0 ? sim::Scenario::kFigureEight : sim::Scenario::kCar;
   sim.duration_s = 60.0;
   sim.speed_m_s = 5.0;
   sim.imu_rate_hz = 50.0;
   sim.initial_yaw_rad = 0.7 * seed;
   sim.seed = static_cast<std::uint64_t>(seed);
-  return estimation::simulate(sim);
+  return sim::simulate(sim);
 }
 
 // Renders `frames` frames of world `seed` into `folder`, numbered from `index`.
@@ -62,12 +62,12 @@ int render_world(const Settings& s, int seed, const std::filesystem::path& folde
   const auto data = drive(seed);
   std::vector<Eigen::Vector3d> path;
   for (const auto& t : data.truth) path.push_back(t.state.position);
-  perception::SimWorldOptions world_options;
+  sim::SimWorldOptions world_options;
   world_options.seed = static_cast<std::uint64_t>(seed);
-  const perception::SimWorld world(path, world_options);
-  perception::SimCameraOptions camera_options;
+  const sim::SimWorld world(path, world_options);
+  sim::SimCameraOptions camera_options;
   camera_options.seed = static_cast<std::uint64_t>(seed);
-  const perception::SimCamera camera(camera_options);
+  const sim::SimCamera camera(camera_options);
   const auto lut = model_class_of_train_id();
   std::mt19937 rng(static_cast<std::uint32_t>(seed));
   std::uniform_int_distribution<std::size_t> pick(data.truth.size() / 20, data.truth.size() - 1);

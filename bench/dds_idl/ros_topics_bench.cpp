@@ -25,8 +25,8 @@
 #include <vector>
 
 #include "child_pipe.hpp"
-#include "costmap_output.hpp"
-#include "mapping_stage.hpp"
+#include "semap/onboard/costmap_output.hpp"
+#include "semap/onboard/mapping_stage.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/dds_idl/reader.hpp"

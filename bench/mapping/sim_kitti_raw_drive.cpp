@@ -11,7 +11,7 @@
 #include "semap/estimation/oxts_writer.hpp"
 #include "semap/map_io/semantic_kitti_io.hpp"
 #include "semap/perception/lidar_projection.hpp"
-#include "semap/perception/sim_camera.hpp"
+#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
 
 namespace semap::bench {
@@ -38,7 +38,7 @@ Eigen::Isometry3d pose_of(const estimation::NavState& s) {
 }
 
 // One Velodyne sweep from `world_from_velo` (world z up, ground at 0), in the sensor frame.
-std::vector<Eigen::Vector4f> cast_scan(const perception::SimWorld& world,
+std::vector<Eigen::Vector4f> cast_scan(const sim::SimWorld& world,
                                        const Eigen::Isometry3f& world_from_velo,
                                        const SimKittiRawOptions& o) {
   std::vector<Eigen::Vector4f> points;
@@ -64,7 +64,7 @@ std::vector<Eigen::Vector4f> cast_scan(const perception::SimWorld& world,
 
 // Map class ids seen by the rectified camera P = [M | p4] posed at world_from_rect, cast every
 // `stride` pixels; 0 where nothing with a map class is seen (sky).
-cv::Mat render_labels(const perception::SimWorld& world, const Eigen::Isometry3f& world_from_rect,
+cv::Mat render_labels(const sim::SimWorld& world, const Eigen::Isometry3f& world_from_rect,
                       const perception::KittiCameraCalibration& calib, int stride) {
   const Eigen::Matrix3d m = calib.p_rect.leftCols<3>();
   const Eigen::Matrix3d m_inv = m.inverse();
@@ -89,9 +89,9 @@ cv::Mat render_labels(const perception::SimWorld& world, const Eigen::Isometry3f
 }
 
 // The simulated colour camera with image_02's pinhole (P_rect_02's left 3x3; no skew).
-perception::SimCamera kitti_colour_camera(const perception::KittiCameraCalibration& calib,
+sim::SimCamera kitti_colour_camera(const perception::KittiCameraCalibration& calib,
                                           std::uint64_t seed) {
-  perception::SimCameraOptions options;
+  sim::SimCameraOptions options;
   options.intrinsics.width = calib.image_size.width;
   options.intrinsics.height = calib.image_size.height;
   options.intrinsics.fx = static_cast<float>(calib.p_rect(0, 0));
@@ -99,7 +99,7 @@ perception::SimCamera kitti_colour_camera(const perception::KittiCameraCalibrati
   options.intrinsics.cx = static_cast<float>(calib.p_rect(0, 2));
   options.intrinsics.cy = static_cast<float>(calib.p_rect(1, 2));
   options.seed = seed;
-  return perception::SimCamera(options);
+  return sim::SimCamera(options);
 }
 
 void write_png(const fs::path& path, const cv::Mat& image) {
@@ -115,11 +115,11 @@ void write_text(const fs::path& path, const std::string& text) {
 
 }  // namespace
 
-perception::SimWorld sim_kitti_raw_world(const SimKittiRawDrive& drive,
+sim::SimWorld sim_kitti_raw_world(const SimKittiRawDrive& drive,
                                          const SimKittiRawOptions& options) {
-  perception::SimWorldOptions world;
+  sim::SimWorldOptions world;
   world.seed = options.seed;
-  return perception::SimWorld(drive.path, world);
+  return sim::SimWorld(drive.path, world);
 }
 
 SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path& kitti_calib,
@@ -146,16 +146,16 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const fs::path& root, const fs::path&
       camera.cam_from_lidar.inverse() * Eigen::Isometry3d(camera.r_rect.transpose());
   // Camera 2's centre in the rectified frame of camera 0: -M^-1 p4 of P_rect_02 = [M | p4].
   const Eigen::Vector3d cam2_centre = -camera.p_rect.leftCols<3>().inverse() * camera.p_rect.col(3);
-  const perception::SimCamera colour = kitti_colour_camera(camera, o.seed);
+  const sim::SimCamera colour = kitti_colour_camera(camera, o.seed);
 
-  estimation::SimulatorConfig sc;
+  sim::SimulatorConfig sc;
   sc.duration_s = o.duration_s;
   sc.seed = o.seed;
-  out.simulation = estimation::simulate(sc);
+  out.simulation = sim::simulate(sc);
   const auto& truth = out.simulation.truth;
   const auto& imu = out.simulation.imu;
   for (const auto& t : truth) out.path.push_back(t.state.position);
-  const perception::SimWorld world = sim_kitti_raw_world(out, o);
+  const sim::SimWorld world = sim_kitti_raw_world(out, o);
   const estimation::LocalEnu enu(out.simulation.origin);
   // World of the street = ENU raised by the IMU height (the street's ground is z = 0).
   Eigen::Isometry3d street_from_enu = Eigen::Isometry3d::Identity();

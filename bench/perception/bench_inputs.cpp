@@ -11,8 +11,8 @@
 #include <string>
 
 #include "semap/perception/palette_segmenter.hpp"
-#include "semap/perception/sim_camera.hpp"
-#include "semap/perception/sim_world.hpp"
+#include "semap/sim/camera.hpp"
+#include "semap/sim/world.hpp"
 // GCC 12 at -O3 reports a false -Wrestrict in the writer's string concatenation (GCC PR 105329).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wrestrict"
@@ -52,12 +52,12 @@ SceneImages render_scene(const onboard::CameraConfig& camera, float depth_scale)
   // A street 60 m long ahead of the camera, in the simulated world the demo drives through.
   std::vector<Eigen::Vector3d> path;
   for (int i = 0; i <= 60; ++i) path.emplace_back(i, 0.0, 0.0);
-  perception::SimWorldOptions world_options;
+  sim::SimWorldOptions world_options;
   world_options.seed = 11;
-  const perception::SimWorld world(path, world_options);
-  perception::SimCameraOptions options;
+  const sim::SimWorld world(path, world_options);
+  sim::SimCameraOptions options;
   options.intrinsics = camera.intrinsics;
-  const auto frame = perception::SimCamera(options).render(world, camera.body_from_optical(), 0);
+  const auto frame = sim::SimCamera(options).render(world, camera.body_from_optical(), 0);
 
   SceneImages out;
   out.camera_bgr = frame.bgr;
@@ -71,7 +71,7 @@ SceneImages render_scene(const onboard::CameraConfig& camera, float depth_scale)
       out.label_bgr.at<cv::Vec3b>(v, u) = cv::Vec3b(rgb[2], rgb[1], rgb[0]);
     }
   }
-  const cv::Mat z16 = perception::depth_to_z16(frame.depth_m, depth_scale);
+  const cv::Mat z16 = sim::depth_to_z16(frame.depth_m, depth_scale);
   out.z16.format = common::PixelFormat::kZ16;
   out.z16.width = static_cast<std::uint32_t>(z16.cols);
   out.z16.height = static_cast<std::uint32_t>(z16.rows);

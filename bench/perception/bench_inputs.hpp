@@ -10,7 +10,7 @@
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
-#include "perception_config.hpp"
+#include "semap/onboard/perception_config.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/estimation/pose_history.hpp"
 

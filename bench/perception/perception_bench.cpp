@@ -20,16 +20,16 @@
 #include <vector>
 
 #include "bench_inputs.hpp"
-#include "mapping_stage.hpp"
-#include "perception_stage.hpp"
-#include "segmenter_factory.hpp"
+#include "semap/onboard/mapping_stage.hpp"
+#include "semap/onboard/perception_stage.hpp"
+#include "semap/onboard/segmenter_factory.hpp"
 #include "semap/drivers/frame_convert.hpp"
 #include "semap/drivers/jpeg_decoder.hpp"
 #include "semap/perception/depth_cloud.hpp"
 #include "semap/perception/onnx_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 #include "semap/perception/sim_classes.hpp"
-#include "shared_pose_history.hpp"
+#include "semap/onboard/shared_pose_history.hpp"
 
 namespace {
 

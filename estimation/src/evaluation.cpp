@@ -15,7 +15,7 @@ constexpr double kRpeSeconds = 10.0;
 constexpr double kSettledDeg = 2.0;
 }  // namespace
 
-EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
+EvaluationRun run_evaluation(const DriveData& data, EstimatorConfig config,
                              const EvaluationOptions& options) {
   EvaluationRun run;
   if (data.imu.empty()) return run;
@@ -57,7 +57,7 @@ EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
   return run;
 }
 
-std::vector<NamedEvaluationRun> run_filters(const SimulationData& data, const EstimatorConfig& base,
+std::vector<NamedEvaluationRun> run_filters(const DriveData& data, const EstimatorConfig& base,
                                             const EvaluationOptions& options,
                                             std::string_view choice) {
   if (choice != "inekf" && choice != "eskf" && choice != "both") {

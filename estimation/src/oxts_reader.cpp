@@ -216,9 +216,9 @@ OxtsData read_oxts_folder(const std::filesystem::path& dir) {
   return out;
 }
 
-SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
+DriveData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
                               OxtsGnssNoise noise) {
-  SimulationData out;
+  DriveData out;
   if (data.records.empty()) return out;
   const auto& first = data.records.front();
   out.origin = Geodetic{first.latitude_deg, first.longitude_deg, first.altitude_m};

@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "costmap_output.hpp"
+#include "semap/onboard/costmap_output.hpp"
 #include "dds_fixture.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/reader.hpp"

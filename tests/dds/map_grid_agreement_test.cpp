@@ -6,7 +6,7 @@
 #include <random>
 
 #include "dds_fixture.hpp"
-#include "mapping_stage.hpp"
+#include "semap/onboard/mapping_stage.hpp"
 #include "semap/dds_idl/map_client.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/mapping/semantic_map.hpp"

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "dds_fixture.hpp"
-#include "dds_outputs.hpp"
-#include "mapping_stage.hpp"
+#include "semap/onboard/dds_outputs.hpp"
+#include "semap/onboard/mapping_stage.hpp"
 #include "ros2_node/map_digest.hpp"
 
 namespace semap::dds_idl::testing {

@@ -7,8 +7,8 @@
 #include <optional>
 
 #include "dds_fixture.hpp"
-#include "dds_outputs.hpp"
-#include "mapping_stage.hpp"
+#include "semap/onboard/dds_outputs.hpp"
+#include "semap/onboard/mapping_stage.hpp"
 #include "semap/dds_idl/reader.hpp"
 #include "semap/dds_idl/topic_names.hpp"
 

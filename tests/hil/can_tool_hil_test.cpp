@@ -17,7 +17,7 @@
 
 #include "hil_env.hpp"
 #include "semap/firmware_bridge/candump_reader.hpp"
-#include "semap/firmware_bridge/emulator.hpp"
+#include "semap/sim/emulator.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
 
 namespace semap::hil {
@@ -56,9 +56,9 @@ TEST(CanToolHil, RecordsALogThatCanplayerReplaysToTheSameSamples) {
   });
   std::this_thread::sleep_for(1s);  // the recorder's socket is bound
   firmware_bridge::CanSocket tx("vcan0", false);
-  firmware_bridge::EmulatorConfig ec;
+  sim::EmulatorConfig ec;
   ec.can_fd = tx.fd();
-  firmware_bridge::Emulator emulator(ec);
+  sim::Emulator emulator(ec);
   for (int i = 0; i < 300; ++i) {
     common::ImuSample s;
     s.stamp = common::Stamp::now();

@@ -17,8 +17,8 @@
 
 #include "hil_env.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
-#include "semap/firmware_bridge/constant_turn_source.hpp"
-#include "semap/firmware_bridge/emulator.hpp"
+#include "semap/sim/constant_turn_source.hpp"
+#include "semap/sim/emulator.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
 
 namespace semap::drivers {
@@ -84,16 +84,16 @@ class VcanTest : public ::testing::Test {
     return c;
   }
 
-  static firmware_bridge::ConstantTurnConfig truth(double seconds) {
-    firmware_bridge::ConstantTurnConfig t;
+  static sim::ConstantTurnConfig truth(double seconds) {
+    sim::ConstantTurnConfig t;
     t.duration_s = seconds;
     t.imu_rate_hz = 400.0;
     t.gnss_rate_hz = 1.0;  // not sent: no serial fd
     return t;
   }
 
-  static firmware_bridge::EmulatorConfig emulator_config(int fd, double speed) {
-    firmware_bridge::EmulatorConfig ec;
+  static sim::EmulatorConfig emulator_config(int fd, double speed) {
+    sim::EmulatorConfig ec;
     ec.can_fd = fd;
     ec.speed = speed;
     return ec;
@@ -128,8 +128,8 @@ TEST_F(VcanTest, Receives400HzFor10sWithoutLossCrcErrorsOrGaps) {
   start_consumer(ring);
 
   firmware_bridge::CanSocket tx(kInterface, false);
-  firmware_bridge::Emulator emulator(emulator_config(tx.fd(), 1.0));
-  firmware_bridge::ConstantTurnSource source(truth(10.0));
+  sim::Emulator emulator(emulator_config(tx.fd(), 1.0));
+  sim::ConstantTurnSource source(truth(10.0));
   const common::Stamp run_start = common::Stamp::now();
   emulator.run(source);
   const common::Stamp run_end = common::Stamp::now();
@@ -187,8 +187,8 @@ TEST_F(VcanTest, CountsInjectedCrcErrorsDropsAndGapsExactly) {
   ec.faults.drop_frame = 0.01;
   ec.faults.sequence_gap = 0.01;
   ec.faults.seed = 3;
-  firmware_bridge::Emulator emulator(ec);
-  firmware_bridge::ConstantTurnSource source(truth(4.0));
+  sim::Emulator emulator(ec);
+  sim::ConstantTurnSource source(truth(4.0));
   emulator.run(source);
   // Clean samples after the run, so a fault in the last sample is detected too.
   emulator.set_faults({});
@@ -255,8 +255,8 @@ TEST_F(VcanTest, CanFdAndJ1939ProfilesArriveComplete) {
     auto ec = emulator_config(tx.fd(), 2.0);
     ec.imu_profile = k.profile;
     ec.can_fd_frames = k.fd;
-    firmware_bridge::Emulator emulator(ec);
-    firmware_bridge::ConstantTurnSource source(truth(2.0));
+    sim::Emulator emulator(ec);
+    sim::ConstantTurnSource source(truth(2.0));
     emulator.run(source);
     const auto sent = emulator.stats();
     EXPECT_TRUE(hil::wait_until([&] { return driver.stats().frames >= sent.imu_samples; }, 5s));
@@ -287,8 +287,8 @@ TEST_F(VcanTest, ResumesAfterInterfaceDownAndUp) {
   start_consumer(ring);
 
   firmware_bridge::CanSocket tx(kInterface, false);
-  firmware_bridge::Emulator emulator(emulator_config(tx.fd(), 1.0));
-  firmware_bridge::ConstantTurnSource source(truth(3.0));
+  sim::Emulator emulator(emulator_config(tx.fd(), 1.0));
+  sim::ConstantTurnSource source(truth(3.0));
   std::jthread sender([&] { emulator.run(source); });
 
   ASSERT_TRUE(hil::wait_until([&] { return driver.stats().frames >= 400; }, 5s));
@@ -340,7 +340,7 @@ TEST_F(VcanTest, ErrorFramesAreCountedAndBusOffRecoversWithoutReconnecting) {
 
   firmware_bridge::CanSocket tx(kInterface, false);
   firmware_bridge::CanSocket errors(kInterface, false);
-  firmware_bridge::Emulator emulator(emulator_config(tx.fd(), 1.0));
+  sim::Emulator emulator(emulator_config(tx.fd(), 1.0));
   std::uint64_t sent = 0;
   const auto send_samples = [&](int n) {
     for (int i = 0; i < n; ++i) {

@@ -12,8 +12,8 @@
 
 #include "hil_env.hpp"
 #include "semap/drivers/gnss_driver.hpp"
-#include "semap/firmware_bridge/constant_turn_source.hpp"
-#include "semap/firmware_bridge/emulator.hpp"
+#include "semap/sim/constant_turn_source.hpp"
+#include "semap/sim/emulator.hpp"
 #include "semap/firmware_bridge/nmea.h"
 #include "semap/firmware_bridge/ubx.h"
 
@@ -74,19 +74,19 @@ class GnssPtyTest : public ::testing::Test {
   }
 
   // 10 s of a 10 Hz receiver, sent 20x faster than real time.
-  static firmware_bridge::EmulatorStats emulate(int fd, GnssProtocol protocol,
-                                                const firmware_bridge::FaultConfig& faults) {
-    firmware_bridge::ConstantTurnConfig truth;
+  static sim::EmulatorStats emulate(int fd, GnssProtocol protocol,
+                                                const sim::FaultConfig& faults) {
+    sim::ConstantTurnConfig truth;
     truth.duration_s = 10.0;
     truth.imu_rate_hz = 10.0;  // IMU events are not sent (no CAN fd); keep them few
     truth.gnss_rate_hz = 10.0;
-    firmware_bridge::ConstantTurnSource source(truth);
-    firmware_bridge::EmulatorConfig ec;
+    sim::ConstantTurnSource source(truth);
+    sim::EmulatorConfig ec;
     ec.serial_fd = fd;
     ec.gnss_protocol = protocol;
     ec.speed = 20.0;
     ec.faults = faults;
-    firmware_bridge::Emulator emulator(ec);
+    sim::Emulator emulator(ec);
     emulator.run(source);
     return emulator.stats();
   }
@@ -175,7 +175,7 @@ TEST_F(GnssPtyTest, NmeaWithFaultsDeliversEveryGoodSentenceAndCountsEveryBadOne)
   constexpr int kBadChecksums = 5;
   for (int i = 0; i < kBadChecksums; ++i)
     write_all(pty.master(), gga(true).data(), gga(true).size());
-  firmware_bridge::FaultConfig faults;
+  sim::FaultConfig faults;
   faults.garbage = 0.2;
   faults.truncate = 0.1;
   faults.seed = 7;
@@ -231,7 +231,7 @@ TEST_F(GnssPtyTest, UbxWithFaultsDeliversEveryGoodFrameAndCountsEveryBadOne) {
   driver.start();
   ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
 
-  firmware_bridge::FaultConfig faults;
+  sim::FaultConfig faults;
   faults.garbage = 0.2;
   faults.truncate = 0.1;
   faults.seed = 11;

@@ -30,7 +30,7 @@ Figures drive(FilterKind kind) {
     SimulatorConfig sc;
     sc.duration_s = 600.0;
     sc.seed = 100 + static_cast<std::uint64_t>(run);
-    const SimulationData data = simulate(sc);
+    const DriveData data = simulate(sc);
     EstimatorConfig ec;
     ec.filter = kind;
     const EvaluationRun r = run_evaluation(data, ec, options);
@@ -68,7 +68,7 @@ double settle_from_180(FilterKind kind, std::uint64_t seed) {
   SimulatorConfig sc;
   sc.duration_s = 60.0;
   sc.seed = seed;
-  const SimulationData data = simulate(sc);
+  const DriveData data = simulate(sc);
   EstimatorConfig ec;
   ec.filter = kind;
   ec.init.yaw_rad = yaw_of(data.truth.front().state.rotation) + std::numbers::pi;

@@ -6,7 +6,7 @@
 
 #include "semap/estimation/estimator_config.hpp"
 #include "semap/estimation/evaluation.hpp"
-#include "semap/estimation/simulator.hpp"
+#include "semap/sim/drive_simulator.hpp"
 #include "semap/estimation/so3.hpp"
 
 namespace semap::estimation::test {
@@ -19,7 +19,7 @@ inline SimulatorConfig drive(double seconds, std::uint64_t seed = 11) {
 }
 
 // A filter told the true initial heading (5 cm rad sigma), so a test is about what follows.
-inline EstimatorConfig heading_known(const SimulationData& data,
+inline EstimatorConfig heading_known(const DriveData& data,
                                      FilterKind filter = FilterKind::kLeftInekf) {
   EstimatorConfig c;
   c.filter = filter;

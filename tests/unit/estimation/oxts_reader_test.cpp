@@ -67,7 +67,7 @@ TEST_F(OxtsFolder, ReadsRecordsAndReportsBadOnes) {
   EXPECT_EQ(r.satellites, 11);
   EXPECT_EQ(r.stamp.ns - d.records[0].stamp.ns, 109991492);
 
-  const SimulationData in = oxts_to_inputs(d, 0.5, 1);
+  const DriveData in = oxts_to_inputs(d, 0.5, 1);
   ASSERT_EQ(in.imu.size(), 3u);
   ASSERT_EQ(in.gnss.size(), 3u);
   EXPECT_NEAR(in.origin.latitude_deg, 49.015, 1e-12);
@@ -113,7 +113,7 @@ TEST_F(OxtsFolder, FilterRunsOnOxtsDrive) {
   const OxtsData d = read_oxts_folder(dir_);
   ASSERT_EQ(d.records.size(), 600u);
   EXPECT_TRUE(d.errors.empty());
-  const SimulationData in = oxts_to_inputs(d, 0.5, 3);
+  const DriveData in = oxts_to_inputs(d, 0.5, 3);
   EstimatorConfig config;
   config.imu_limits.max_dt_s = 0.25;  // 10 Hz OXTS
   config.init.yaw_rad = 2.0;          // 115 deg off

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "semap/estimation/oxts_reader.hpp"
-#include "semap/estimation/simulator.hpp"
+#include "semap/sim/drive_simulator.hpp"
 #include "semap/estimation/so3.hpp"
 
 namespace semap::estimation {
@@ -21,7 +21,7 @@ TEST(OxtsWriter, TimestampRoundTrips) {
   EXPECT_EQ(parse_kitti_timestamp(text)->ns, stamp.ns);
 }
 
-SimulationData simulated_car(double seconds) {
+DriveData simulated_car(double seconds) {
   SimulatorConfig sc;
   sc.duration_s = seconds;
   return simulate(sc);
@@ -31,7 +31,7 @@ SimulationData simulated_car(double seconds) {
 // (noise-free) fix equals the simulator's, so the reader's frames (body x forward, y left,
 // z up; ENU world; yaw from east) and signs are the simulator's.
 TEST(OxtsWriter, ConversionMatchesTheSimulatorsTruth) {
-  const SimulationData sim = simulated_car(40.0);
+  const DriveData sim = simulated_car(40.0);
   const LocalEnu enu(sim.origin);
   OxtsData data;
   for (std::size_t i = 0; i < sim.imu.size(); i += 7) {
@@ -42,7 +42,7 @@ TEST(OxtsWriter, ConversionMatchesTheSimulatorsTruth) {
     read->stamp = written.stamp;
     data.records.push_back(*read);
   }
-  const SimulationData in = oxts_to_inputs(data, 1e-9, 1);
+  const DriveData in = oxts_to_inputs(data, 1e-9, 1);
   ASSERT_EQ(in.imu.size(), data.records.size());
   const LocalEnu back(in.origin);
   for (std::size_t k = 0; k < in.imu.size(); ++k) {
@@ -73,13 +73,13 @@ TEST(OxtsWriter, ConversionMatchesTheSimulatorsTruth) {
 }
 
 TEST(OxtsWriter, PacketAccuracyIsTheFixSigma) {
-  const SimulationData sim = simulated_car(10.0);
+  const DriveData sim = simulated_car(10.0);
   OxtsData data;
   for (std::size_t i = 0; i < 3; ++i) {
     data.records.push_back(oxts_record_from_state(
         sim.truth[i].state, sim.imu[i], LocalEnu(sim.origin), 0.5 * static_cast<double>(i)));
   }
-  const SimulationData in = oxts_to_inputs(data, 7.0, 1, OxtsGnssNoise::kPacketAccuracy);
+  const DriveData in = oxts_to_inputs(data, 7.0, 1, OxtsGnssNoise::kPacketAccuracy);
   EXPECT_DOUBLE_EQ(in.gnss[0].covariance(0, 0), kMinPacketSigmaM * kMinPacketSigmaM);
   EXPECT_DOUBLE_EQ(in.gnss[1].covariance(1, 1), 0.25);
   EXPECT_DOUBLE_EQ(in.gnss[2].covariance(2, 2), 1.0);

@@ -97,7 +97,7 @@ TEST_F(SemapKittiRawDrive, FilterBeatsGnssAndTheMapHoldsTheStreet) {
   const auto read = mapping::read_smap(out / "map.smap");
   const auto cells = occupied_cells(read.map);
   ASSERT_GT(cells.size(), 1000u);
-  const perception::SimWorld world = bench::sim_kitti_raw_world(*drive_);
+  const sim::SimWorld world = bench::sim_kitti_raw_world(*drive_);
   const Eigen::Vector3d lift(0.0, 0.0, 0.93);
   std::map<int, std::size_t> seen;
   std::size_t agree = 0;

@@ -1,4 +1,4 @@
-#include "health_monitor.hpp"
+#include "semap/onboard/health_monitor.hpp"
 
 #include <gtest/gtest.h>
 

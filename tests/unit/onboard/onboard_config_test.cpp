@@ -1,14 +1,14 @@
 // semap-onboard's configuration: the shipped examples load as documented, and a bad camera,
 // depth or segmenter section stops start-up with the file and key named.
-#include "onboard_config.hpp"
+#include "semap/onboard/onboard_config.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "dds_outputs.hpp"
-#include "segmenter_factory.hpp"
+#include "semap/onboard/dds_outputs.hpp"
+#include "semap/onboard/segmenter_factory.hpp"
 #include "semap/common/config.hpp"
 
 namespace semap::onboard {

@@ -1,6 +1,6 @@
 // The onboard perception stage on real rings, a real palette segmenter and a pose history:
 // frames in, posed labelled clouds out, every frame that cannot be used counted by reason.
-#include "perception_stage.hpp"
+#include "semap/onboard/perception_stage.hpp"
 
 #include <gtest/gtest.h>
 

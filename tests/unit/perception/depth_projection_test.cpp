@@ -7,9 +7,9 @@
 #include <opencv2/core.hpp>
 
 #include "semap/perception/depth_cloud.hpp"
-#include "semap/perception/sim_camera.hpp"
+#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
-#include "semap/perception/sim_world.hpp"
+#include "semap/sim/world.hpp"
 
 namespace semap::perception {
 namespace {

@@ -9,9 +9,9 @@
 
 #include "semap/perception/model_card.hpp"
 #include "semap/perception/onnx_segmenter.hpp"
-#include "semap/perception/sim_camera.hpp"
+#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
-#include "semap/perception/sim_world.hpp"
+#include "semap/sim/world.hpp"
 
 namespace semap::perception {
 namespace {

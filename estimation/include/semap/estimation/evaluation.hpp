@@ -6,7 +6,7 @@
 
 #include "semap/estimation/estimator.hpp"
 #include "semap/estimation/metrics.hpp"
-#include "semap/estimation/simulator.hpp"
+#include "semap/estimation/drive_data.hpp"
 
 namespace semap::estimation {
 
@@ -41,7 +41,7 @@ struct EvaluationRun {
 
 // Runs an Estimator over simulated (or recorded) data in arrival order and scores it against
 // the truth. The estimator is anchored at data.origin so truth and estimate share a frame.
-EvaluationRun run_evaluation(const SimulationData& data, EstimatorConfig config,
+EvaluationRun run_evaluation(const DriveData& data, EstimatorConfig config,
                              const EvaluationOptions& options);
 
 struct NamedEvaluationRun {
@@ -51,7 +51,7 @@ struct NamedEvaluationRun {
 
 // run_evaluation with `base` for each filter of an evaluation tool's --filter choice ("inekf",
 // "eskf" or "both", InEKF first). Throws std::invalid_argument for another choice.
-std::vector<NamedEvaluationRun> run_filters(const SimulationData& data, const EstimatorConfig& base,
+std::vector<NamedEvaluationRun> run_filters(const DriveData& data, const EstimatorConfig& base,
                                             const EvaluationOptions& options,
                                             std::string_view choice);
 

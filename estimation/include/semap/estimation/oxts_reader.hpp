@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "semap/common/stamp.hpp"
-#include "semap/estimation/simulator.hpp"
+#include "semap/estimation/drive_data.hpp"
 
 namespace semap::estimation {
 
@@ -63,7 +63,7 @@ inline constexpr double kMinPacketSigmaM = 0.01;
 // GNSS fixes from the positions plus seeded white noise (gnss_sigma_m per axis, or the packet's
 // pos_accuracy with kPacketAccuracy) and that sigma as covariance, and the OXTS solution as
 // truth (biases unknown, left zero), anchored at the first record.
-SimulationData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
+DriveData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
                               OxtsGnssNoise noise = OxtsGnssNoise::kFixedSigma);
 
 }  // namespace semap::estimation

@@ -1,0 +1,95 @@
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "semap/onboard/latency_window.hpp"
+#include "semap/onboard/onboard_config.hpp"
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/estimation/estimator.hpp"
+#include "semap/onboard/shared_pose_history.hpp"
+#include "semap/onboard/stage_thread.hpp"
+#include "semap/onboard/trajectory_log.hpp"
+
+namespace semap::onboard {
+
+struct EstimationStageStats {
+  std::uint64_t imu_samples = 0;
+  std::uint64_t gnss_fixes = 0;
+  std::uint64_t poses_published = 0;
+  // When the heading first met map.start_heading_sigma_deg; poses go to perception from then.
+  std::optional<common::Stamp> heading_settled;
+  bool initialised = false;
+  estimation::EstimatorCounters estimator;
+  std::optional<estimation::StampedPose> latest;
+  std::optional<estimation::Geodetic> anchor;
+  Eigen::Vector3d anchor_offset = Eigen::Vector3d::Zero();
+};
+
+// A pose with the filter's covariance, for whoever publishes it.
+struct PoseOutput {
+  estimation::StampedPose pose;
+  Eigen::Vector3d angular_velocity_body = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d position_covariance = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Identity();
+};
+
+// What the estimation stage reads: the `estimator` section, and from `map` and `dds` the heading
+// that starts mapping and the odometry rate.
+struct EstimationStageConfig {
+  estimation::EstimatorConfig estimator;
+  double map_start_heading_sigma_deg = 3.0;
+  double odometry_hz = 50.0;
+  std::filesystem::path trajectory;  // --trajectory: every pose as CSV (TrajectoryLog)
+  std::int64_t trajectory_offset_ns = 0;
+};
+
+// Owns the Estimator on its own thread: drains the IMU and GNSS rings in stamp order and
+// shares the filter's poses with the perception stage, which poses frames at their stamps,
+// once the filter's heading has settled (map.start_heading_sigma_deg).
+class EstimationStage {
+ public:
+  using PoseSink = std::function<void(const PoseOutput&)>;
+
+  EstimationStage(const EstimationStageConfig& config, common::SpscRing<common::ImuSample>& imu,
+                  common::SpscRing<common::GnssFix>& gnss, SharedPoseHistory& poses,
+                  PoseSink pose_sink);
+  ~EstimationStage();
+  EstimationStage(const EstimationStage&) = delete;
+  EstimationStage& operator=(const EstimationStage&) = delete;
+
+  void start();
+  void stop();
+  EstimationStageStats stats() const;
+  // Age of each IMU sample when the filter has taken it (driver stamp to filter).
+  const LatencyWindow& imu_latency() const { return imu_latency_; }
+
+ private:
+  void run(std::stop_token stop);
+  bool drain_sensors();
+  void publish_pose();
+  void check_heading();
+  void share_stats();
+
+  EstimationStageConfig config_;
+  common::SpscRing<common::ImuSample>& imu_ring_;
+  common::SpscRing<common::GnssFix>& gnss_ring_;
+  SharedPoseHistory& poses_;
+  PoseSink pose_sink_;
+  estimation::Estimator estimator_;
+  std::vector<estimation::StampedPose> new_poses_;
+  std::unique_ptr<TrajectoryLog> trajectory_;
+  common::Stamp next_heading_check_;
+  common::ImuSample last_imu_;
+  common::Stamp next_pose_publish_;
+  LatencyWindow imu_latency_;
+  StageThread<EstimationStageStats> stage_;  // last: joined before the members it uses
+};
+
+}  // namespace semap::onboard

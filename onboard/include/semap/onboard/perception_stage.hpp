@@ -1,0 +1,118 @@
+#pragma once
+
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "semap/onboard/latency_window.hpp"
+#include "semap/onboard/perception_config.hpp"
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/drivers/jpeg_decoder.hpp"
+#include "semap/perception/labelled_points.hpp"
+#include "semap/perception/segmentation.hpp"
+#include "semap/onboard/shared_pose_history.hpp"
+#include "semap/onboard/stage_thread.hpp"
+
+namespace semap::perception {
+class StereoDepth;
+}
+
+namespace semap::onboard {
+
+struct PerceptionStageStats {
+  // Counted in colour frames: each frame taken becomes a cloud or one of the losses below.
+  std::uint64_t frames = 0;        // colour frames taken from the ring
+  std::uint64_t clouds = 0;        // posed clouds handed to the mapping stage
+  std::uint64_t skipped = 0;       // passed over for a newer frame (the stage fell behind)
+  std::uint64_t unpaired = 0;      // no depth frame within the sync tolerance
+  std::uint64_t depth_unused = 0;  // depth frames no colour frame paired with
+  std::uint64_t bad_frames = 0;    // undecodable, wrong format or wrong size
+  std::uint64_t without_pose = 0;  // before the filter started, or older than its history
+  std::uint64_t points = 0;        // labelled points handed on
+  perception::DropCounts dropped;  // pixels dropped on the way to points, by reason
+  double segment_seconds_total = 0.0;
+  double segment_seconds_max = 0.0;
+};
+
+// Owns the camera's half of the pipeline on its own thread: takes colour frames (and depth
+// frames of a separate depth device) from the drivers' rings, pairs them by stamp, segments,
+// turns labelled pixels with depth into points in the body frame, poses them at the frame's
+// stamp from the estimation stage's history and hands the cloud to the mapping stage.
+// It keeps only the newest frame when it falls behind: drivers never wait for it.
+class PerceptionStage {
+ public:
+  PerceptionStage(const CameraConfig& camera, const DepthConfig& depth,
+                  std::unique_ptr<perception::Segmenter> segmenter,
+                  common::SpscRing<common::ImageFrame>& colour,
+                  common::SpscRing<common::ImageFrame>* depth_frames,
+                  const SharedPoseHistory& poses, common::SpscRing<common::LabeledCloud>& clouds);
+  ~PerceptionStage();
+  PerceptionStage(const PerceptionStage&) = delete;
+  PerceptionStage& operator=(const PerceptionStage&) = delete;
+
+  // Called on the stage's thread after each segmentation with the colour frame's sequence and
+  // stamp, the BGR image the segmenter saw and its result (evaluation on the simulated rig).
+  // It delays the stage while it runs. Set before start().
+  using SegmentationObserver =
+      std::function<void(std::uint32_t sequence, common::Stamp stamp, const cv::Mat& bgr,
+                         const perception::Segmentation&)>;
+  void set_observer(SegmentationObserver observer) { observer_ = std::move(observer); }
+  // Sees every frame taken from the rings, colour and depth, on the stage's thread (a
+  // recorder). Set before start().
+  using FrameTap = std::function<void(const common::ImageFrame&, bool depth)>;
+  void set_frame_tap(FrameTap tap) { tap_ = std::move(tap); }
+
+  void start();
+  void stop();
+  PerceptionStageStats stats() const;
+  // Age of each frame (its capture stamp) when its posed cloud goes to the mapping stage.
+  const LatencyWindow& latency() const { return latency_; }
+  std::uint32_t queue_depth() const;
+  // The segmenter and depth source, for the log.
+  std::string describe() const;
+
+  // One round of the stage's loop, for tests that drive it without its thread: takes what
+  // the rings hold, processes at most one frame, poses what the filter has reached.
+  // Returns whether it did anything.
+  bool step();
+
+ private:
+  struct BodyCloud {
+    common::LabeledCloud cloud;  // body frame
+    std::uint32_t sequence = 0;
+  };
+
+  void run(std::stop_token stop);
+  bool take_frames();
+  bool process_next();
+  void process(const common::ImageFrame& colour, const common::ImageFrame* depth);
+  bool pose_clouds();
+  void reject(const common::ImageFrame& frame, const std::string& why);
+  void share_stats();
+
+  CameraConfig camera_;
+  DepthConfig depth_;
+  std::unique_ptr<perception::Segmenter> segmenter_;
+  SegmentationObserver observer_;
+  FrameTap tap_;
+  std::unique_ptr<perception::StereoDepth> stereo_;
+  common::SpscRing<common::ImageFrame>& colour_ring_;
+  common::SpscRing<common::ImageFrame>* depth_ring_;
+  const SharedPoseHistory& poses_;
+  common::SpscRing<common::LabeledCloud>& cloud_ring_;
+  Eigen::Isometry3f body_from_optical_;
+  drivers::JpegDecoder jpeg_;
+  std::deque<common::ImageFrame> colour_pending_;
+  std::deque<common::ImageFrame> depth_pending_;
+  std::deque<BodyCloud> unposed_;
+  LatencyWindow latency_;
+  StageThread<PerceptionStageStats> stage_;  // last: joined before the members it uses
+};
+
+// A body-frame cloud in the world frame, with the robot at `pose`.
+common::LabeledCloud to_world(common::LabeledCloud cloud, const estimation::StampedPose& pose);
+
+}  // namespace semap::onboard

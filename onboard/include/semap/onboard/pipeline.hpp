@@ -1,0 +1,125 @@
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/onboard/dds_outputs.hpp"
+#include "semap/onboard/estimation_stage.hpp"
+#include "semap/onboard/health_monitor.hpp"
+#include "semap/onboard/mapping_stage.hpp"
+#include "semap/onboard/onboard_config.hpp"
+#include "semap/onboard/perception_stage.hpp"
+#include "semap/onboard/run_figures.hpp"
+#include "semap/onboard/sensor_rig.hpp"
+#include "semap/onboard/shared_pose_history.hpp"
+
+namespace semap::onboard {
+
+// Watches the pipeline without being part of it: a report, a recorder, a viewer. Each call
+// comes on the thread its comment names and must not block for long; every one is optional.
+class PipelineObserver {
+ public:
+  virtual ~PipelineObserver() = default;
+  // The estimation stage's state, about ten times a second (the thread calling tick()).
+  virtual void on_estimate(const EstimationStageStats&) {}
+  // Each pose the estimation stage publishes, at dds.odometry_hz (the estimation thread).
+  virtual void on_pose(const PoseOutput&) {}
+  // Each colour or depth frame the perception stage takes (the perception thread).
+  virtual void on_frame(const common::ImageFrame&, bool /*depth*/) {}
+  // Each segmentation: its colour frame's sequence and stamp, the BGR image the segmenter saw
+  // and its result (the perception thread).
+  virtual void on_segmentation(std::uint32_t /*sequence*/, common::Stamp, const cv::Mat& /*bgr*/,
+                               const perception::Segmentation&) {}
+  // A cloud is in the map; these blocks changed (the mapping thread).
+  virtual void on_mapped(std::span<const common::BlockIndex> /*changed*/) {}
+  // The pipeline has stopped: every stage has emptied its input (the thread calling stop()).
+  virtual void on_stopped() {}
+  // Its lines for the exit summary (after stop()).
+  virtual void summary(std::vector<std::string>&) const {}
+};
+
+// The robot's pipeline, built from an OnboardConfig: the rings, the sensor rig that fills them,
+// the estimation stage (IMU + GNSS -> poses), the perception stage (frames -> posed labelled
+// clouds, when the rig has a camera and the segmenter loads), the mapping stage (S-BKI, with its
+// checkpoint) and the DDS outputs. Each stage runs on its own thread; the caller's thread calls
+// tick() while the robot runs.
+class Pipeline {
+ public:
+  using RigFactory = std::function<std::unique_ptr<SensorRig>(const SensorRings&)>;
+
+  // Builds everything; nothing runs yet. `trajectory`: every pose of the filter as CSV.
+  // Throws when the checkpoint cannot be opened or its map is anchored elsewhere than
+  // estimator.anchor says.
+  Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
+           const std::filesystem::path& trajectory = {});
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  // Before start().
+  void attach(PipelineObserver& observer) { observers_.push_back(&observer); }
+  SensorRig& rig() { return *rig_; }
+  const SensorRig& rig() const { return *rig_; }
+
+  void start();
+  // The caller's share while the robot runs, every ~100 ms: anchors the map's frame once the
+  // filter has one, publishes health once a second and logs progress every five.
+  void tick();
+  // The rig has played all it had (a drive, a recording, the run's duration).
+  bool finished() const { return rig_->finished(); }
+  // Stops in the order data flows: the rig first (nothing more enters the rings), then each
+  // stage once it has emptied its input, so every cloud made is in the map or counted as
+  // dropped; then the outputs publish the map's last changes.
+  void stop();
+
+  // Whether frames are segmented and mapped (the rig has a camera and the segmenter loaded).
+  bool perceiving() const { return perception_ != nullptr; }
+  EstimationStageStats estimation() const { return estimation_->stats(); }
+  std::optional<PerceptionStageStats> perception() const;
+  MappingStageStats mapping() const { return mapping_->stats(); }
+  const MappingStage& mapping_stage() const { return *mapping_; }
+  const std::filesystem::path& checkpoint_path() const { return checkpoint_path_; }
+  // Every ring's drops, by name.
+  std::vector<std::pair<std::string, std::uint64_t>> ring_drops() const;
+  // After stop(): the whole map (read back from the checkpoint when it was paged).
+  const mapping::SemanticMap& map() { return mapping_->map(); }
+  // After stop(): the exit summary, one line per part (tests read them).
+  std::vector<std::string> summary() const;
+
+ private:
+  // Fast replay: true once the stages have taken all that the rig handed over.
+  bool has_taken(const HandedOver& handed) const;
+  Rings rings() const;
+
+  OnboardConfig config_;
+  common::SpscRing<common::ImuSample> imu_ring_;
+  common::SpscRing<common::GnssFix> gnss_ring_;
+  common::SpscRing<common::ImageFrame> colour_ring_;
+  common::SpscRing<common::ImageFrame> depth_ring_;
+  common::SpscRing<common::LabeledCloud> cloud_ring_;
+  SharedPoseHistory poses_;
+  std::unique_ptr<SensorRig> rig_;
+  std::vector<PipelineObserver*> observers_;
+  std::filesystem::path checkpoint_path_;
+  // Declared in the order they may be destroyed last: the publisher reads the mapping stage.
+  std::unique_ptr<MappingStage> mapping_;
+  std::unique_ptr<DdsOutputs> dds_;
+  std::unique_ptr<PerceptionStage> perception_;
+  std::unique_ptr<EstimationStage> estimation_;
+  HealthMonitor health_;
+  Progress progress_;
+  common::Stamp started_;
+  common::Stamp next_health_;
+  common::Stamp next_progress_;
+  bool frame_recorded_ = false;
+  bool running_ = false;
+};
+
+}  // namespace semap::onboard

@@ -1,0 +1,54 @@
+#pragma once
+
+// What the pipeline reports while the robot runs: the progress line every few seconds and the
+// health figures per stage.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "semap/onboard/estimation_stage.hpp"
+#include "semap/onboard/health_monitor.hpp"
+#include "semap/onboard/mapping_stage.hpp"
+#include "semap/onboard/perception_stage.hpp"
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+
+namespace semap::onboard {
+
+class DdsOutputs;
+
+// Rings feeding each stage, for the health report.
+struct Rings {
+  const common::SpscRing<common::ImuSample>& imu;
+  const common::SpscRing<common::GnssFix>& gnss;
+  const common::SpscRing<common::ImageFrame>& colour;
+  const common::SpscRing<common::ImageFrame>& depth;
+  const common::SpscRing<common::LabeledCloud>& clouds;
+};
+
+template <typename... R>
+std::uint32_t queued(const R&... rings) {
+  return static_cast<std::uint32_t>((rings.size() + ...));
+}
+template <typename... R>
+std::uint64_t drops(const R&... rings) {
+  return (rings.counters().drops() + ...);
+}
+
+std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& estimation,
+                                        const PerceptionStage* perception,
+                                        const MappingStage& mapping, const DdsOutputs& dds);
+
+// Rates over the last interval, ring depths and drops: the progress line every few seconds.
+class Progress {
+ public:
+  std::string line(double t, const EstimationStageStats& est,
+                   const PerceptionStageStats& perception, const MappingStageStats& map,
+                   const Rings& r);
+
+ private:
+  double last_t_ = 0.0;
+  std::uint64_t imu_ = 0, gnss_ = 0, frames_ = 0, clouds_ = 0, scans_ = 0;
+};
+
+}  // namespace semap::onboard

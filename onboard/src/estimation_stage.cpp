@@ -1,0 +1,141 @@
+#include "semap/onboard/estimation_stage.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "semap/common/logging.hpp"
+
+namespace semap::onboard {
+
+EstimationStage::EstimationStage(const EstimationStageConfig& config,
+                                 common::SpscRing<common::ImuSample>& imu,
+                                 common::SpscRing<common::GnssFix>& gnss, SharedPoseHistory& poses,
+                                 PoseSink pose_sink)
+    : config_(config),
+      imu_ring_(imu),
+      gnss_ring_(gnss),
+      poses_(poses),
+      pose_sink_(std::move(pose_sink)),
+      estimator_(config.estimator) {
+  if (!config.trajectory.empty()) {
+    trajectory_ = std::make_unique<TrajectoryLog>(config.trajectory, config.trajectory_offset_ns);
+  }
+}
+
+EstimationStage::~EstimationStage() { stop(); }
+
+void EstimationStage::start() {
+  stage_.start([this](std::stop_token stop) { run(stop); });
+}
+
+void EstimationStage::stop() { stage_.stop(); }
+
+EstimationStageStats EstimationStage::stats() const { return stage_.stats(); }
+
+void EstimationStage::run(std::stop_token stop) {
+  // Asked to stop, it first takes what the rings still hold (the rig has stopped filling them).
+  while (true) {
+    const bool busy = drain_sensors();
+    publish_pose();
+    share_stats();
+    if (busy) continue;
+    if (stop.stop_requested()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  share_stats();
+}
+
+// Feeds what the rings hold. The IMU and GNSS drivers run on separate threads, so a fix may
+// be popped before IMU samples that precede it: the estimator holds it until the IMU reaches its
+// stamp (the one place sensor streams are put in time order), so fixes go in first.
+bool EstimationStage::drain_sensors() {
+  std::array<common::ImuSample, 64> imu_batch;
+  std::array<common::GnssFix, 8> gnss_batch;
+  const std::size_t n_imu = imu_ring_.try_pop_batch(imu_batch);
+  const std::size_t n_gnss = gnss_ring_.try_pop_batch(gnss_batch);
+  for (std::size_t g = 0; g < n_gnss; ++g) estimator_.add_gnss(gnss_batch[g]);
+  stage_.figures().gnss_fixes += n_gnss;
+  for (std::size_t i = 0; i < n_imu; ++i) {
+    last_imu_ = imu_batch[i];
+    estimator_.add_imu(imu_batch[i]);
+    ++stage_.figures().imu_samples;
+    // Per sample, not per batch: when mapping starts then depends on the samples only, not on
+    // how the thread happened to batch them (a replay maps what its recording mapped).
+    check_heading();
+    if (!stage_.figures().heading_settled && !trajectory_) continue;
+    const auto pose = estimator_.pose_at(estimator_.filter_time());
+    if (!pose) continue;
+    if (trajectory_) trajectory_->write(*pose);
+    if (stage_.figures().heading_settled) new_poses_.push_back(*pose);
+  }
+  if (n_imu > 0) {
+    const common::Stamp done = common::Stamp::now();
+    for (std::size_t k = 0; k < n_imu; ++k) {
+      imu_latency_.record(common::seconds_between(done, imu_batch[k].stamp));
+    }
+  }
+  if (!new_poses_.empty()) {
+    poses_.append(new_poses_);
+    new_poses_.clear();
+  }
+  return n_imu + n_gnss > 0;
+}
+
+// The yaw variance needs the covariance, which the InEKF forms on demand: ten checks per
+// second of filter time until the heading has settled once.
+void EstimationStage::check_heading() {
+  if (stage_.figures().heading_settled || !estimator_.initialised()) return;
+  const common::Stamp now = estimator_.filter_time();
+  if (now < next_heading_check_) return;
+  next_heading_check_ = now + 0.1;
+  const double yaw_sigma_deg =
+      std::sqrt(estimator_.filter().rotation_covariance_world()(2, 2)) * 180.0 / std::numbers::pi;
+  if (yaw_sigma_deg > config_.map_start_heading_sigma_deg) return;
+  stage_.figures().heading_settled = now;
+  common::logger("estimation")
+      ->info("heading settled (sigma {:.2f} deg): camera frames are mapped from now on",
+             yaw_sigma_deg);
+}
+
+void EstimationStage::publish_pose() {
+  if (!pose_sink_ || !estimator_.initialised()) return;
+  // The covariance is read only for a pose that is published (odometry rate).
+  const common::Stamp stamp = estimator_.filter_time();
+  if (stamp < next_pose_publish_) return;
+  next_pose_publish_ = stamp + 1.0 / config_.odometry_hz;
+  const estimation::NavFilter& filter = estimator_.filter();
+  const estimation::NavState state = filter.state();
+  PoseOutput out;
+  out.pose.stamp = stamp;
+  out.pose.orientation = Eigen::Quaterniond(state.rotation);
+  out.pose.position = state.position;
+  out.pose.velocity = state.velocity;
+  out.angular_velocity_body = last_imu_.gyro - state.gyro_bias;
+  out.position_covariance = filter.position_covariance_world();
+  out.rotation_covariance = filter.rotation_covariance_world();
+  pose_sink_(out);
+  ++stage_.figures().poses_published;
+}
+
+void EstimationStage::share_stats() {
+  stage_.figures().initialised = estimator_.initialised();
+  stage_.figures().estimator = estimator_.counters();
+  if (estimator_.initialised()) {
+    const estimation::NavState state = estimator_.filter().state();
+    estimation::StampedPose p;
+    p.stamp = estimator_.filter_time();
+    p.orientation = Eigen::Quaterniond(state.rotation);
+    p.position = state.position;
+    p.velocity = state.velocity;
+    stage_.figures().latest = p;
+  }
+  stage_.figures().anchor = estimator_.anchor();
+  stage_.figures().anchor_offset = estimator_.anchor_offset();
+  stage_.share();
+}
+
+}  // namespace semap::onboard

@@ -1,0 +1,25 @@
+#include "semap/onboard/shared_pose_history.hpp"
+
+namespace semap::onboard {
+
+void SharedPoseHistory::append(std::span<const estimation::StampedPose> poses) {
+  std::lock_guard lock(mutex_);
+  for (const auto& p : poses) history_.push(p);
+}
+
+void SharedPoseHistory::clear() {
+  std::lock_guard lock(mutex_);
+  history_.clear();
+}
+
+SharedPoseHistory::Lookup SharedPoseHistory::at(common::Stamp stamp) const {
+  std::lock_guard lock(mutex_);
+  const auto newest = history_.newest();
+  if (!newest) return {Status::kNoFilter, {}};
+  if (stamp > newest->stamp) return {Status::kPending, {}};
+  const auto pose = history_.at(stamp);
+  if (!pose) return {Status::kTooOld, {}};
+  return {Status::kPosed, *pose};
+}
+
+}  // namespace semap::onboard

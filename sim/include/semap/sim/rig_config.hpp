@@ -1,0 +1,30 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "semap/onboard/onboard_config.hpp"
+#include "semap/sim/camera_feed.hpp"
+#include "semap/sim/drive_simulator.hpp"
+
+namespace semap::sim {
+
+// The simulated rig's own keys in the `rig:` section: the drive, the street world and what the
+// camera shows.
+struct SimRigConfig {
+  SimulatorConfig trajectory;    // scenario, speed_m_s, imu_rate_hz, gnss_rate_hz, ... seed
+  std::uint32_t scene_seed = 7;  // the street world and the camera's noise
+  double world_density = 1.0;    // scales the number of buildings, trees, cars and poles
+  SimCameraImage camera_image = SimCameraImage::kRgb;
+  // A V4L2 video output device (vivid's, looped to its capture side): the rig writes its colour
+  // frames there as BGR24 and a CameraDriver on camera.device captures them back. Empty: the
+  // frames go straight into the colour ring.
+  std::string camera_output;
+};
+
+// Reads the simulated rig's keys into `out` when load_onboard_config calls it, and checks the
+// rest of the configuration against the rig (aligned depth only; with camera_output, BGR24 and
+// a sync tolerance below half the frame period).
+onboard::RigKeys sim_rig_keys(SimRigConfig& out);
+
+}  // namespace semap::sim

@@ -1,0 +1,55 @@
+#include "semap/sim/rig_config.hpp"
+
+namespace semap::sim {
+
+using common::ConfigSection;
+
+namespace {
+
+void read_keys(const ConfigSection& s, SimRigConfig& rig) {
+  auto& t = rig.trajectory;
+  t.scenario = s.get_choice("scenario", "figure8", {"car", "figure8"}) == "car"
+                   ? Scenario::kCar
+                   : Scenario::kFigureEight;
+  t.speed_m_s = s.get_in_range("speed_m_s", 5.0, 0.5, 40.0);
+  t.imu_rate_hz = s.get_in_range("imu_rate_hz", 200.0, 50.0, 1000.0);
+  t.gnss_rate_hz = s.get_in_range("gnss_rate_hz", 10.0, 1.0, 20.0);
+  t.gnss_sigma_m = s.get_in_range("gnss_sigma_m", 0.5, 0.01, 10.0);
+  t.static_s = s.get_in_range("static_s", 3.0, 1.0, 60.0);
+  t.seed = static_cast<std::uint64_t>(s.get<int>("seed", 1));
+  rig.scene_seed = static_cast<std::uint32_t>(s.get<int>("scene_seed", 7));
+  rig.world_density = s.get_in_range("world_density", rig.world_density, 0.0, 4.0);
+  rig.camera_image = s.get_choice("camera_image", "rgb", {"rgb", "classes"}) == "rgb"
+                         ? SimCameraImage::kRgb
+                         : SimCameraImage::kClasses;
+  rig.camera_output = s.get<std::string>("camera_output", "");
+}
+
+}  // namespace
+
+onboard::RigKeys sim_rig_keys(SimRigConfig& out) {
+  return [&out](const ConfigSection& rig, const ConfigSection& root, onboard::OnboardConfig& c) {
+    read_keys(rig, out);
+    if (c.rig.kind == onboard::RigKind::kSim && c.depth.source != onboard::DepthSource::kAligned) {
+      root.section_or_empty("depth").reject("source", "the simulated rig renders aligned depth only");
+    }
+    if (out.camera_output.empty()) return;
+    if (c.rig.kind != onboard::RigKind::kSim) {
+      rig.reject("camera_output", "only the simulated rig writes camera frames");
+    }
+    // The frames come back at the device's capture rate, each one repeated until the next; a
+    // colour frame pairs with the depth frame within the tolerance, which must therefore stay
+    // below half the rig's frame period (see SimCameraFeed).
+    if (c.depth.sync_tolerance_s >= 0.5 / c.camera.driver.fps) {
+      root.section_or_empty("depth").reject(
+          "sync_tolerance_ms",
+          "must be below half the camera's frame period with rig.camera_output");
+    }
+    // The rig writes BGR24 and the capture side must ask for the same format.
+    const auto camera = root.section_or_empty("camera");
+    if (camera.has("format")) camera.reject("format", "rig.camera_output sets it (BGR24)");
+    c.camera.driver.format = common::PixelFormat::kBgr24;
+  };
+}
+
+}  // namespace semap::sim
