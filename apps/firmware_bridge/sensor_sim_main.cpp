@@ -17,10 +17,10 @@
 
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/drivers/can_socket.hpp"
 #include "semap/drivers/serial_port.hpp"
 #include "semap/sim/constant_turn_source.hpp"
 #include "semap/sim/emulator.hpp"
-#include "semap/firmware_bridge/linux_can.hpp"
 
 namespace {
 
@@ -192,9 +192,9 @@ int main(int argc, char** argv) {
     config.gnss_protocol = protocol == "ubx" ? fb::GnssProtocol::kUbx : fb::GnssProtocol::kNmea;
     config.speed = speed;
     config.faults = faults;
-    std::unique_ptr<fb::CanSocket> can;
+    std::unique_ptr<semap::drivers::CanSocket> can;
     if (!can_if.empty()) {
-      can = std::make_unique<fb::CanSocket>(can_if, can_fd);
+      can = std::make_unique<semap::drivers::CanSocket>(can_if, can_fd);
       config.can_fd = can->fd();
     }
     SerialOutput serial_out;

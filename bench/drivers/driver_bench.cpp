@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "semap/drivers/can_imu_driver.hpp"
+#include "semap/drivers/can_socket.hpp"
 #include "semap/drivers/gnss_driver.hpp"
 #include "semap/firmware_bridge/can_imu.h"
 #include "semap/firmware_bridge/linux_can.hpp"
@@ -126,7 +127,7 @@ void BM_VcanWriteToRingPop(benchmark::State& state) {
     state.SkipWithError("CAN driver did not start");
     return;
   }
-  fb::CanSocket tx("vcan0", false);
+  drivers::CanSocket tx("vcan0", false);
   std::vector<double> latencies;
   std::vector<double> kernel_to_pop;
   for (auto _ : state) {

@@ -93,6 +93,9 @@ CanSocket::CanSocket(const std::string& interface,
   }
 }
 
+CanSocket::CanSocket(const std::string& interface, bool enable_fd)
+    : CanSocket(interface, {}, enable_fd) {}
+
 CanSocket::~CanSocket() { ::close(fd_); }
 
 CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {

@@ -1,57 +1,14 @@
 #include "semap/firmware_bridge/linux_can.hpp"
 
 #include <linux/can.h>
-#include <linux/can/raw.h>
-#include <net/if.h>
-#include <sys/ioctl.h>
-#include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
-#include <stdexcept>
 
 namespace semap::firmware_bridge {
-
-namespace {
-
-[[noreturn]] void fail(int fd, const std::string& interface, const std::string& what) {
-  const int err = errno;
-  if (fd >= 0) ::close(fd);
-  throw std::runtime_error("CAN interface '" + interface + "': " + what + ": " +
-                           std::strerror(err));
-}
-
-}  // namespace
-
-CanSocket::CanSocket(const std::string& interface, bool fd_frames) {
-  if (interface.empty() || interface.size() >= IFNAMSIZ) {
-    throw std::runtime_error("CAN interface name '" + interface + "' is empty or too long");
-  }
-  const int fd = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
-  if (fd < 0) fail(fd, interface, "socket(PF_CAN, SOCK_RAW, CAN_RAW)");
-  ifreq ifr{};
-  std::memcpy(ifr.ifr_name, interface.c_str(), interface.size() + 1);
-  if (::ioctl(fd, SIOCGIFINDEX, &ifr) < 0) fail(fd, interface, "no such interface");
-  if (fd_frames) {
-    const int on = 1;
-    if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on) < 0) {
-      fail(fd, interface, "CAN FD frames not supported");
-    }
-  }
-  sockaddr_can addr{};
-  addr.can_family = AF_CAN;
-  addr.can_ifindex = ifr.ifr_ifindex;
-  if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) < 0) {
-    fail(fd, interface, "bind");
-  }
-  fd_ = fd;
-}
-
-CanSocket::~CanSocket() {
-  if (fd_ >= 0) ::close(fd_);
-}
 
 bool write_can_frame(int fd, const SemapCanFrame& frame) {
   canfd_frame kernel{};

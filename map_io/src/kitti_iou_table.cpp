@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -13,15 +12,6 @@
 namespace semap::map_io {
 
 namespace {
-
-// Class 0 (unlabelled) is never scored, as in the SemanticKITTI benchmark.
-std::vector<int> present_classes(const ConfusionMatrix& confusion) {
-  std::vector<int> classes;
-  for (int c = 1; c < kKittiClasses; ++c) {
-    if (confusion.truth_count(c) > 0) classes.push_back(c);
-  }
-  return classes;
-}
 
 void append_cell(std::string& out, const char* text, std::size_t width) {
   out.append(width + 1 - std::min(width, std::strlen(text)), ' ');
@@ -40,9 +30,9 @@ void append_percent(std::string& out, double fraction, std::size_t width) {
 
 }  // namespace
 
-double kitti_mean_iou(const ConfusionMatrix& confusion) {
-  const std::vector<int> classes = present_classes(confusion);
-  return confusion.mean_iou(classes);
+// Class 0 (unlabelled) is never scored, as in the SemanticKITTI benchmark.
+double kitti_mean_iou(const mapping::ConfusionMatrix& confusion) {
+  return confusion.mean_iou_of_present(1);
 }
 
 std::string format_kitti_iou_table(std::span<const IouTableRow> rows) {
@@ -66,13 +56,11 @@ std::string format_kitti_iou_table(std::span<const IouTableRow> rows) {
   widths.push_back(std::strlen("average"));
   append_cell(out, "average", widths.back());
   out += '\n';
-  const double absent = std::numeric_limits<double>::quiet_NaN();
   for (const IouTableRow& row : rows) {
     out += row.name;
     out.append(name_width - row.name.size(), ' ');
     for (int c = 1; c < kKittiClasses; ++c) {
-      const bool present = row.confusion->truth_count(c) > 0;
-      append_percent(out, present ? row.confusion->iou(c) : absent,
+      append_percent(out, row.confusion->iou_if_present(c),
                      widths[static_cast<std::size_t>(c - 1)]);
     }
     append_percent(out, kitti_mean_iou(*row.confusion), widths.back());

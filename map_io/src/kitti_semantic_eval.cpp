@@ -21,19 +21,20 @@ struct PendingScan {
   std::vector<std::uint16_t> truth;
 };
 
-// SemanticKITTI's benchmark ignores unlabelled points; ConfusionMatrix ignores truth -1.
+// SemanticKITTI's benchmark ignores unlabelled points; mapping::ConfusionMatrix ignores truth -1.
 int scored_truth(std::uint16_t truth) { return truth == 0 ? -1 : truth; }
 
-ConfusionMatrix score_map_at(const mapping::SemanticMap& map, const PendingScan& scan) {
+mapping::ConfusionMatrix score_map_at(const mapping::SemanticMap& map, const PendingScan& scan) {
   return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, scan.points.size(), 4096), ConfusionMatrix(kKittiClasses),
-      [&](const tbb::blocked_range<std::size_t>& range, ConfusionMatrix m) {
+      tbb::blocked_range<std::size_t>(0, scan.points.size(), 4096),
+      mapping::ConfusionMatrix(kKittiClasses),
+      [&](const tbb::blocked_range<std::size_t>& range, mapping::ConfusionMatrix m) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           m.add(scored_truth(scan.truth[i]), map.label_at(scan.points[i]));
         }
         return m;
       },
-      [](ConfusionMatrix a, const ConfusionMatrix& b) {
+      [](mapping::ConfusionMatrix a, const mapping::ConfusionMatrix& b) {
         a.merge(b);
         return a;
       });
@@ -122,7 +123,7 @@ KittiSemanticResult evaluate_kitti_semantic(
     mapping::MapParams p = config.params;
     p.method = method;
     maps.emplace_back(p);
-    result.maps.push_back(KittiMapResult{method, ConfusionMatrix(kKittiClasses), {}, {}});
+    result.maps.push_back(KittiMapResult{method, mapping::ConfusionMatrix(kKittiClasses), {}, {}});
   }
   std::deque<PendingScan> pending;
   const auto score_oldest = [&] {

@@ -38,8 +38,7 @@ class Fd {
 
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes,
-                           bool durable) {
+void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes) {
   const std::filesystem::path dir =
       path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   // Hidden, unique name next to the target so rename() stays within one file system.
@@ -62,7 +61,7 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
       if (n < 0) fail(temp, "write", errno);
       written += static_cast<std::size_t>(n);
     }
-    if (durable && ::fsync(fd.get()) != 0) fail(temp, "fsync", errno);
+    if (::fsync(fd.get()) != 0) fail(temp, "fsync", errno);
     if (::close(fd.release()) != 0) fail(temp, "close", errno);
     if (::rename(temp.c_str(), path.c_str()) != 0) fail(path, "rename", errno);
   } catch (...) {
@@ -70,7 +69,6 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
     std::filesystem::remove(temp, ignored);
     throw;
   }
-  if (!durable) return;
   Fd dir_fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY));
   if (dir_fd.get() < 0) fail(dir, "open directory", errno);
   if (::fsync(dir_fd.get()) != 0) fail(dir, "fsync directory", errno);

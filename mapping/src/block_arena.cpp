@@ -13,7 +13,7 @@ namespace semap::mapping {
 namespace {
 
 // Chunks double from 16 KiB to 32 MiB (16 huge pages, a few hundred LiDAR blocks). The small
-// ones come from calloc, whose freed memory the next map reuses without page faults (a tile, a
+// ones come from calloc, whose freed memory the next map reuses without page faults (a merge, a
 // file read); the large ones are anonymous mappings with huge pages. Untouched pages of a
 // mapping cost address space only.
 constexpr std::size_t kFirstChunkBytes = std::size_t{16} << 10;

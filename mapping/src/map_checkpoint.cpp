@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace semap::mapping {
 
@@ -108,6 +109,9 @@ MapCheckpoint::Stats MapCheckpoint::stats() const {
 
 MapPager::MapPager(SemanticMap& map, BlockLog& log, double radius_m)
     : map_(map), log_(log), radius_(radius_m) {
+  // A radius of zero or less would write out every block before each insert and read it
+  // back right after (as a late restore): a wrong config, not a small memory budget.
+  if (!(radius_m > 0.0)) throw std::invalid_argument("MapPager: radius must be positive");
   for (const common::BlockIndex& index : log_.blocks()) {
     if (map_.find_block(index) == nullptr) out_.insert(index);
   }
@@ -126,10 +130,9 @@ void MapPager::after_insert(const InsertResult& result) {
 
 void MapPager::update(const Eigen::Vector3f& robot) {
   const common::MapGrid grid = map_.params().grid();
-  const float side = map_.params().block_size();
+  const float side = grid.block_size();
   const auto distance = [&](const common::BlockIndex& index) {
-    const Eigen::Vector3f centre = grid.block_origin(index) + Eigen::Vector3f::Constant(side / 2);
-    return static_cast<double>((centre - robot).norm());
+    return static_cast<double>((grid.block_centre(index) - robot).norm());
   };
   std::vector<common::BlockIndex> far;
   map_.for_each_block([&](const common::BlockIndex& index, const Block&) {

@@ -315,10 +315,10 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
   return result;
 }
 
-void write_smap(const std::filesystem::path& path, const LayeredMap& map, bool durable) {
+void write_smap(const std::filesystem::path& path, const LayeredMap& map) {
   // Temporaries of earlier writers to this path that were killed mid-write.
   remove_stale_temporaries(path);
-  write_file_atomically(path, encode_smap(map), durable);
+  write_file_atomically(path, encode_smap(map));
 }
 
 SmapReadResult read_smap(const std::filesystem::path& path, const SmapReadOptions& options) {

@@ -8,7 +8,7 @@
 #include "semap/onboard/rig_clock.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/drivers/frame_convert.hpp"
-#include "semap/firmware_bridge/linux_can.hpp"
+#include "semap/drivers/can_socket.hpp"
 #include "semap/sim/sensor_source.hpp"
 
 namespace semap::sim {
@@ -97,7 +97,7 @@ SimRig::SimRig(const onboard::OnboardConfig& config, const SimRigConfig& sim,
     emu.j1939_source = static_cast<std::uint8_t>(decoder.j1939_source);
   }
   if (!config.imu.interface.empty()) {
-    can_socket_ = std::make_unique<firmware_bridge::CanSocket>(config.imu.interface, false);
+    can_socket_ = std::make_unique<drivers::CanSocket>(config.imu.interface, false);
     emu.can_fd = can_socket_->fd();
     drivers_.add_imu(config.imu.driver, rings.imu);
   } else {

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "hil_env.hpp"
+#include "semap/drivers/can_socket.hpp"
 #include "semap/firmware_bridge/candump_reader.hpp"
 #include "semap/sim/emulator.hpp"
-#include "semap/firmware_bridge/linux_can.hpp"
 
 namespace semap::hil {
 namespace {
@@ -55,7 +55,7 @@ TEST(CanToolHil, RecordsALogThatCanplayerReplaysToTheSameSamples) {
     EXPECT_EQ(std::system(cmd.c_str()), 0) << read_file(dir / "record.out");
   });
   std::this_thread::sleep_for(1s);  // the recorder's socket is bound
-  firmware_bridge::CanSocket tx("vcan0", false);
+  drivers::CanSocket tx("vcan0", false);
   sim::EmulatorConfig ec;
   ec.can_fd = tx.fd();
   sim::Emulator emulator(ec);

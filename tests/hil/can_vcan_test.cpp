@@ -19,7 +19,6 @@
 #include "semap/drivers/can_imu_driver.hpp"
 #include "semap/sim/constant_turn_source.hpp"
 #include "semap/sim/emulator.hpp"
-#include "semap/firmware_bridge/linux_can.hpp"
 
 namespace semap::drivers {
 namespace {
@@ -127,7 +126,7 @@ TEST_F(VcanTest, Receives400HzFor10sWithoutLossCrcErrorsOrGaps) {
       << driver.last_error();
   start_consumer(ring);
 
-  firmware_bridge::CanSocket tx(kInterface, false);
+  CanSocket tx(kInterface, false);
   sim::Emulator emulator(emulator_config(tx.fd(), 1.0));
   sim::ConstantTurnSource source(truth(10.0));
   const common::Stamp run_start = common::Stamp::now();
@@ -181,7 +180,7 @@ TEST_F(VcanTest, CountsInjectedCrcErrorsDropsAndGapsExactly) {
   ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
   start_consumer(ring);
 
-  firmware_bridge::CanSocket tx(kInterface, false);
+  CanSocket tx(kInterface, false);
   auto ec = emulator_config(tx.fd(), 2.0);
   ec.faults.crc_error = 0.02;
   ec.faults.drop_frame = 0.01;
@@ -251,7 +250,7 @@ TEST_F(VcanTest, CanFdAndJ1939ProfilesArriveComplete) {
     driver.start();
     ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
 
-    firmware_bridge::CanSocket tx(kInterface, k.fd);
+    CanSocket tx(kInterface, k.fd);
     auto ec = emulator_config(tx.fd(), 2.0);
     ec.imu_profile = k.profile;
     ec.can_fd_frames = k.fd;
@@ -286,7 +285,7 @@ TEST_F(VcanTest, ResumesAfterInterfaceDownAndUp) {
   ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
   start_consumer(ring);
 
-  firmware_bridge::CanSocket tx(kInterface, false);
+  CanSocket tx(kInterface, false);
   sim::Emulator emulator(emulator_config(tx.fd(), 1.0));
   sim::ConstantTurnSource source(truth(3.0));
   std::jthread sender([&] { emulator.run(source); });
@@ -338,8 +337,8 @@ TEST_F(VcanTest, ErrorFramesAreCountedAndBusOffRecoversWithoutReconnecting) {
   ASSERT_TRUE(hil::wait_until([&] { return driver.state() == DriverState::kRunning; }, 5s));
   start_consumer(ring);
 
-  firmware_bridge::CanSocket tx(kInterface, false);
-  firmware_bridge::CanSocket errors(kInterface, false);
+  CanSocket tx(kInterface, false);
+  CanSocket errors(kInterface, false);
   sim::Emulator emulator(emulator_config(tx.fd(), 1.0));
   std::uint64_t sent = 0;
   const auto send_samples = [&](int n) {

@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <vector>
 
 #include "../mapping/toy_dataset.hpp"
@@ -12,22 +11,6 @@ namespace semap::map_io {
 namespace {
 
 using namespace semap::mapping;
-
-TEST(ConfusionMatrix, IouCountsUnknownAsAMiss) {
-  ConfusionMatrix m(3);
-  m.add(1, 1);
-  m.add(1, 1);
-  m.add(1, 2);  // FN for 1, FP for 2
-  m.add(2, 2);
-  m.add(2, -1);  // unknown: FN for 2
-  m.add(7, 1);   // ignored truth
-  EXPECT_EQ(m.total(), 5u);
-  EXPECT_DOUBLE_EQ(m.iou(1), 2.0 / 3.0);
-  EXPECT_DOUBLE_EQ(m.iou(2), 1.0 / 3.0);
-  EXPECT_TRUE(std::isnan(m.iou(0)));
-  const std::vector<int> classes{0, 1, 2};
-  EXPECT_DOUBLE_EQ(m.mean_iou(classes), 0.5);
-}
 
 TEST(LabelNoise, FlipsTheRequestedFractionToOtherClasses) {
   common::LabeledCloud c;

@@ -186,7 +186,7 @@ TEST(KittiSemanticEval, MapsFromNoisyGroundTruthBeatTheirInput) {
 }
 
 TEST(KittiIouTable, RefusesRowsOfOtherClassCounts) {
-  const ConfusionMatrix four(4);
+  const mapping::ConfusionMatrix four(4);
   const std::vector<IouTableRow> rows{{"x", &four}};
   EXPECT_THROW(format_kitti_iou_table(rows), std::invalid_argument);
 }

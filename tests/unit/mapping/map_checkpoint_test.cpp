@@ -7,7 +7,9 @@
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "toy_dataset.hpp"
 
@@ -202,6 +204,106 @@ TEST(MapPager, LongDriveStaysBoundedAndLosesNothing) {
   SemanticMap reloaded(params);
   BlockLog(dir / "map.log", params).load_all(reloaded);
   expect_same_map(reference, reloaded);
+  fs::remove_all(dir);
+}
+
+// Blocks along the x axis, block i filled with evidence i + 1, for the pager's distance rule.
+// With resolution 0.2 and depth 3 a block is 0.8 m, so from the centre of block 0 the centre of
+// block i is 0.8 * |i| m away.
+MapParams row_params() {
+  MapParams params;
+  params.resolution = 0.2f;
+  params.block_depth = 3;
+  return params;
+}
+
+std::vector<float> row_evidence(const MapParams& params, int i) {
+  return std::vector<float>(static_cast<std::size_t>(params.cells_per_block() * params.num_classes),
+                            static_cast<float>(std::abs(i) + 1));
+}
+
+void add_row(SemanticMap& map, int first, int last) {
+  for (int i = first; i <= last; ++i) {
+    map.add_evidence({i, 0, 0}, row_evidence(map.params(), i));
+  }
+}
+
+bool resident(const SemanticMap& map, int i) { return map.find_block({i, 0, 0}) != nullptr; }
+
+// A block leaves memory when its centre is farther than radius + one block from the robot and
+// comes back only within the radius: a block that the robot's jitter moves across the radius
+// stays where it is.
+TEST(MapPager, EvictsBeyondRadiusPlusABlockAndRestoresWithinTheRadius) {
+  const fs::path dir = scratch_dir("hysteresis");
+  const MapParams params = row_params();
+  SemanticMap map(params);
+  add_row(map, -6, 6);
+  BlockLog log(dir / "map.log", params, false);
+  // Radius 3.9 m: blocks +-5 (centres 4.0 m away) lie between the radius and radius + one block
+  // (4.7 m); blocks +-6 (4.8 m) lie beyond it. Their corners nearest the robot are 4.4 m away,
+  // so a rule on block origins or corners would keep them.
+  MapPager pager(map, log, 3.9);
+  const Eigen::Vector3f centre_of_block_0 = params.grid().block_centre({0, 0, 0});
+  pager.update(centre_of_block_0);
+  EXPECT_TRUE(resident(map, 5));
+  EXPECT_TRUE(resident(map, -5));
+  EXPECT_FALSE(resident(map, 6));
+  EXPECT_FALSE(resident(map, -6));
+  EXPECT_EQ(pager.paged_out(), 2u);
+  EXPECT_EQ(pager.stats().evicted, 2u);
+
+  // One block towards +x: block 6 is now 4.0 m away, outside the radius: it stays on disk.
+  const Eigen::Vector3f one_block = Eigen::Vector3f::UnitX() * params.block_size();
+  pager.update(centre_of_block_0 + one_block);
+  EXPECT_FALSE(resident(map, 6));
+  EXPECT_EQ(pager.stats().restored, 0u);
+
+  // Two blocks towards +x: block 6 is 3.2 m away and comes back with its evidence.
+  pager.update(centre_of_block_0 + 2 * one_block);
+  ASSERT_TRUE(resident(map, 6));
+  const auto evidence = map.find_block({6, 0, 0})->evidence();
+  EXPECT_EQ(std::vector<float>(evidence.begin(), evidence.end()), row_evidence(params, 6));
+  EXPECT_EQ(pager.stats().restored, 1u);
+  fs::remove_all(dir);
+}
+
+// A resumed map that is paged starts empty: the log's blocks count as paged out and come back
+// as the robot gets near them, each with the evidence the log holds.
+TEST(MapPager, PagesInTheBlocksOfAResumedLog) {
+  const fs::path dir = scratch_dir("resume_paged");
+  const MapParams params = row_params();
+  {
+    SemanticMap before(params);
+    add_row(before, 0, 9);
+    BlockLog log(dir / "map.log", params, false);
+    before.for_each_block([&](const common::BlockIndex& index, const Block& block) {
+      log.append(index, 1, block.evidence(), block.observed_words());
+    });
+    log.commit(1);
+  }
+  SemanticMap map(params);
+  BlockLog log(dir / "map.log", params, false);
+  MapPager pager(map, log, 2.0);
+  EXPECT_EQ(pager.paged_out(), 10u);
+  pager.update(params.grid().block_centre({0, 0, 0}));
+  // Blocks 0, 1 and 2 (centres 0, 0.8 and 1.6 m away) are within the radius.
+  EXPECT_EQ(map.stats().blocks, 3u);
+  EXPECT_EQ(pager.paged_out(), 7u);
+  for (int i = 0; i <= 2; ++i) {
+    ASSERT_TRUE(resident(map, i)) << "block " << i;
+    const auto evidence = map.find_block({i, 0, 0})->evidence();
+    EXPECT_EQ(std::vector<float>(evidence.begin(), evidence.end()), row_evidence(params, i));
+  }
+  fs::remove_all(dir);
+}
+
+TEST(MapPager, RefusesARadiusThatIsNotPositive) {
+  const fs::path dir = scratch_dir("radius");
+  const MapParams params = row_params();
+  SemanticMap map(params);
+  BlockLog log(dir / "map.log", params, false);
+  EXPECT_THROW(MapPager(map, log, 0.0), std::invalid_argument);
+  EXPECT_THROW(MapPager(map, log, -1.0), std::invalid_argument);
   fs::remove_all(dir);
 }
 

@@ -100,6 +100,9 @@ class MapGrid {
                            static_cast<float>(block.z)) *
            block_size();
   }
+  Eigen::Vector3f block_centre(const BlockIndex& block) const {
+    return block_origin(block) + Eigen::Vector3f::Constant(block_size() / 2);
+  }
 
  private:
   float resolution_;

@@ -35,6 +35,9 @@ class CanSocket {
   // of it, so 1 MiB rides out ~0.8 s of a stalled reader at 1200 frames/s.
   CanSocket(const std::string& interface, std::span<const firmware_bridge::CanIdFilter> filters,
             bool enable_fd, int receive_buffer = 1 << 20);
+  // A socket that only sends (a firmware emulator or a test writing frames to fd()): with no
+  // filters the kernel queues it no data frames, which nobody would read.
+  CanSocket(const std::string& interface, bool enable_fd);
   ~CanSocket();
   CanSocket(const CanSocket&) = delete;
   CanSocket& operator=(const CanSocket&) = delete;

@@ -3,7 +3,7 @@
 #include <span>
 #include <string>
 
-#include "semap/map_io/evaluation.hpp"
+#include "semap/mapping/confusion_matrix.hpp"
 
 namespace semap::map_io {
 
@@ -11,12 +11,12 @@ namespace semap::map_io {
 // SemanticKITTI learning classes, unlabelled points already left out.
 struct IouTableRow {
   std::string name;
-  const ConfusionMatrix* confusion = nullptr;
+  const mapping::ConfusionMatrix* confusion = nullptr;
 };
 
 // Mean IoU over the classes 1..19 present in the ground truth (as the paper averages a
 // sequence); NaN when none is present.
-double kitti_mean_iou(const ConfusionMatrix& confusion);
+double kitti_mean_iou(const mapping::ConfusionMatrix& confusion);
 
 // The rows in the layout of Table IV of Gan et al.: a header with the 19 class names and
 // `average`, then per row its name, each class's IoU in percent with one decimal (`n/a` for a

@@ -40,18 +40,18 @@ struct KittiSemanticConfig {
 // One map's figures.
 struct KittiMapResult {
   mapping::MapMethod method = mapping::MapMethod::kBki;
-  ConfusionMatrix confusion{kKittiClasses};
+  mapping::ConfusionMatrix confusion{kKittiClasses};
   std::vector<double> insert_seconds;  // per inserted scan: training set and fusion
   mapping::MapStats stats;
 };
 
 struct KittiSemanticResult {
-  ConfusionMatrix input{kKittiClasses};  // the labels the maps were built from
-  std::vector<KittiMapResult> maps;      // in config.methods' order
-  std::size_t scans = 0;                 // read, inserted and scored
-  std::size_t points = 0;                // in those scans
-  std::size_t unscored_points = 0;       // ground truth unlabelled (class 0): not scored
-  std::size_t unlabeled_inputs = 0;      // input label 0: not inserted (class 0 is free space)
+  mapping::ConfusionMatrix input{kKittiClasses};  // the labels the maps were built from
+  std::vector<KittiMapResult> maps;               // in config.methods' order
+  std::size_t scans = 0;                          // read, inserted and scored
+  std::size_t points = 0;                         // in those scans
+  std::size_t unscored_points = 0;                // ground truth unlabelled (class 0): not scored
+  std::size_t unlabeled_inputs = 0;  // input label 0: not inserted (class 0 is free space)
   std::size_t flipped_labels = 0;
   std::vector<std::string> bad_scans;  // scans skipped, one message each naming the file
 };

@@ -11,14 +11,11 @@ namespace semap::mapping {
 // Replaces `path` with `bytes` so that a crash leaves either the old or the new file, never a
 // mix: the bytes go to a temporary file in the same directory, which is fsynced, renamed over
 // `path`, and the directory is fsynced so the rename itself is durable.
-// With `durable` false the fsyncs are skipped: still atomic against a crashing process, not
-// against power loss (for scratch data such as tiles of a map that is saved properly later).
 // Throws std::runtime_error naming the path and the failing step; on any failure the temporary
 // is removed and `path` is untouched. A writer that is killed (SIGKILL, power cut) cannot remove
 // its temporary: `.NAME.XXXXXX` stays next to the target until remove_stale_temporaries.
 // The temporary is flock()ed while it is written.
-void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes,
-                           bool durable = true);
+void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
 
 // Removes the temporaries write_file_atomically left for `path` when its writer died: names
 // `.NAME.XXXXXX` in the same directory that no process holds locked and that were last written

@@ -63,7 +63,7 @@ class EvidenceGrid {
   bool evict(const common::BlockIndex& key);
   // Storage for `blocks` more blocks in one piece: a map that will grow large asks for it at
   // once (a huge-page mapping, address space only until blocks are written), a small one
-  // (a tile, a merge) does not. Throws std::bad_alloc when the system refuses.
+  // (a file read, a merge) does not. Throws std::bad_alloc when the system refuses.
   void reserve(std::size_t blocks);
 
   // Calls f(const common::BlockIndex&, const Block&) for every block in memory, in the order

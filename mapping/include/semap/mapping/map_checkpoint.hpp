@@ -110,7 +110,8 @@ class MapPager {
     std::uint64_t late_restores = 0;  // blocks an insert reached before update() restored them
   };
 
-  // `log`'s blocks not in `map` count as paged out (a resumed map).
+  // `log`'s blocks not in `map` count as paged out (a resumed map). Throws
+  // std::invalid_argument unless radius_m > 0.
   MapPager(SemanticMap& map, BlockLog& log, double radius_m);
 
   void update(const Eigen::Vector3f& robot);

@@ -46,7 +46,7 @@ SmapReadResult decode_smap(std::span<const std::uint8_t> bytes, const std::strin
                            const SmapReadOptions& options = {});
 
 // Crash-safe write (see write_file_atomically).
-void write_smap(const std::filesystem::path& path, const LayeredMap& map, bool durable = true);
+void write_smap(const std::filesystem::path& path, const LayeredMap& map);
 SmapReadResult read_smap(const std::filesystem::path& path, const SmapReadOptions& options = {});
 
 }  // namespace semap::mapping

@@ -12,7 +12,7 @@
 #include "semap/common/spsc_ring.hpp"
 #include "semap/sim/drive_simulator.hpp"
 #include "semap/sim/emulator.hpp"
-#include "semap/firmware_bridge/linux_can.hpp"
+#include "semap/drivers/can_socket.hpp"
 #include "semap/sim/world.hpp"
 #include "semap/sim/camera_feed.hpp"
 #include "semap/sim/rig_config.hpp"
@@ -69,7 +69,7 @@ class SimRig final : public onboard::SensorRig {
   Eigen::Isometry3f body_from_optical_;
   std::unique_ptr<onboard::PseudoTerminal> pty_;
   std::string gnss_device_;
-  std::unique_ptr<firmware_bridge::CanSocket> can_socket_;
+  std::unique_ptr<drivers::CanSocket> can_socket_;
   firmware_bridge::CanImuDecoder busless_decoder_;
   common::Stamp busless_stamp_;  // the stamp of the IMU sample being sent without a bus
   std::function<void(common::Stamp, const SemapCanFrame&, bool)> can_tap_;
