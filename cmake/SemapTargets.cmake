@@ -135,6 +135,17 @@ function(semap_test name)
   if(ARG_ENV)
     set_tests_properties(${name} PROPERTIES ENVIRONMENT "${ARG_ENV}")
   endif()
+  semap_sanitizer_suite(${name} ${name})
+endfunction()
+
+# semap_sanitizer_suite(TEST TARGETS...): when TEST is in SEMAP_SANITIZER_SUITE (tests/), labels it
+# `sanitize` and makes the target `sanitizer_suite` build TARGETS, so the sanitizer presets build
+# and run that suite alone.
+function(semap_sanitizer_suite test)
+  if(TARGET sanitizer_suite AND test IN_LIST SEMAP_SANITIZER_SUITE)
+    set_property(TEST ${test} APPEND PROPERTY LABELS sanitize)
+    add_dependencies(sanitizer_suite ${ARGN})
+  endif()
 endfunction()
 
 # semap_bench(NAME SOURCES ... LIBS ...): a Google Benchmark binary in build/bin.

@@ -12,8 +12,8 @@
 #include "semap/estimation/estimator_config.hpp"
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/oxts_reader.hpp"
-#include "semap/sim/drive_simulator.hpp"
 #include "semap/estimation/so3.hpp"
+#include "semap/sim/drive_simulator.hpp"
 #include "top_view.hpp"
 
 namespace est = semap::estimation;
@@ -77,12 +77,13 @@ int main(int argc, char** argv) {
           "OXTS: %zu records over %.1f s\n", oxts.records.size(),
           semap::common::seconds_between(oxts.records.back().stamp, oxts.records.front().stamp));
     } else {
-      est::SimulatorConfig sc;
-      sc.scenario = scenario == "figure8" ? est::Scenario::kFigureEight : est::Scenario::kCar;
+      semap::sim::SimulatorConfig sc;
+      sc.scenario =
+          scenario == "figure8" ? semap::sim::Scenario::kFigureEight : semap::sim::Scenario::kCar;
       sc.duration_s = duration;
       sc.gnss_sigma_m = gnss_sigma;
       sc.seed = seed;
-      data = est::simulate(sc);
+      data = semap::sim::simulate(sc);
       options.motion_start_s = sc.static_s;
       std::printf("scenario %s: %.0f s, IMU %zu samples, GNSS %zu fixes (sigma %.2f m)\n",
                   scenario.c_str(), duration, data.imu.size(), data.gnss.size(), gnss_sigma);

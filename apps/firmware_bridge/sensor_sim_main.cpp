@@ -65,8 +65,8 @@ void open_serial(SerialOutput& out, bool use_pty, const std::string& device, int
   ::fcntl(out.fd, F_SETFL, ::fcntl(out.fd, F_GETFL) | O_NONBLOCK);
 }
 
-fb::ConstantTurnConfig trajectory_from(const semap::common::ConfigSection& t) {
-  fb::ConstantTurnConfig c;
+semap::sim::ConstantTurnConfig trajectory_from(const semap::common::ConfigSection& t) {
+  semap::sim::ConstantTurnConfig c;
   const std::vector<double> origin =
       t.get<std::vector<double>>("origin", {c.origin_lat_deg, c.origin_lon_deg, c.origin_alt_m});
   if (origin.size() != 3) {
@@ -84,8 +84,8 @@ fb::ConstantTurnConfig trajectory_from(const semap::common::ConfigSection& t) {
   return c;
 }
 
-void print_stats(const fb::EmulatorStats& s) {
-  const fb::InjectedFaults& i = s.injected;
+void print_stats(const semap::sim::EmulatorStats& s) {
+  const semap::sim::InjectedFaults& i = s.injected;
   std::printf(
       "sent: imu_samples=%llu can_frames=%llu can_write_failures=%llu gnss_epochs=%llu "
       "nmea_sentences=%llu ubx_frames=%llu serial_bytes=%llu serial_dropped_bytes=%llu\n",
@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
   double speed = 1.0;
   std::string config_path;
   std::string log_level = "info";
-  fb::FaultConfig faults;
+  semap::sim::FaultConfig faults;
   app.add_option("--can-if", can_if, "CAN interface for the IMU (e.g. vcan0); none: no IMU");
   app.add_flag("--can-fd", can_fd, "semap profile: one 64-byte CAN FD frame per sample");
   app.add_option("--imu-profile", imu_profile, "IMU protocol")
@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
     if (faults.crc_error + faults.drop_frame + faults.sequence_gap > 1.0) {
       throw std::runtime_error("--crc-error + --drop-frame + --sequence-gap must not exceed 1");
     }
-    fb::ConstantTurnConfig trajectory;
+    semap::sim::ConstantTurnConfig trajectory;
     if (!config_path.empty()) {
       const auto root = semap::common::ConfigSection::load_file(config_path);
       trajectory = trajectory_from(root.section("trajectory"));
@@ -184,7 +184,7 @@ int main(int argc, char** argv) {
     }
     trajectory.duration_s = duration;
 
-    fb::EmulatorConfig config;
+    semap::sim::EmulatorConfig config;
     config.imu_profile = imu_profile == "j1939" ? fb::ImuProfile::kJ1939 : fb::ImuProfile::kSemap;
     config.can_fd_frames = can_fd;
     config.base_id = base_id;
@@ -209,9 +209,10 @@ int main(int argc, char** argv) {
     std::signal(SIGTERM, on_signal);
     // The trajectory source is an interface: the estimation simulator or an OXTS reader can
     // replace the built-in constant-turn drive here.
-    std::unique_ptr<fb::SensorSource> source = std::make_unique<fb::ConstantTurnSource>(trajectory);
+    std::unique_ptr<semap::sim::SensorSource> source =
+        std::make_unique<semap::sim::ConstantTurnSource>(trajectory);
     log->info("running {:.1f} s of sensor time at speed {}", duration, speed);
-    fb::Emulator emulator(config);
+    semap::sim::Emulator emulator(config);
     emulator.run(*source, &g_stop);
     print_stats(emulator.stats());
   } catch (const std::exception& e) {

@@ -16,7 +16,6 @@
 #include <thread>
 
 #include "semap/common/logging.hpp"
-#include "semap/mapping/smap_io.hpp"
 #include "semap/onboard/hardware_rig.hpp"
 #include "semap/onboard/pipeline.hpp"
 #include "semap/onboard/replay_rig.hpp"
@@ -97,13 +96,8 @@ int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_confi
   service.stopping();
   pipeline.stop();
 
-  std::vector<std::filesystem::path> saves;
-  if (!config.map.save_path.empty()) saves.emplace_back(config.map.save_path);
-  if (report && !report->dir().empty()) saves.push_back(report->dir() / "map.smap");
-  for (const auto& path : saves) {
-    mapping::write_smap(path, pipeline.map().layers());
-    log->info("map saved to {}", path.string());
-  }
+  if (!config.map.save_path.empty()) pipeline.save_map(config.map.save_path);
+  if (report && !report->dir().empty()) pipeline.save_map(report->dir() / "map.smap");
   std::printf("\n== semap-onboard summary ==\n");
   for (const auto& line : pipeline.summary()) std::printf("%s\n", line.c_str());
   const double wall_s =
@@ -171,7 +165,8 @@ int main(int argc, char** argv) {
       config.rig.replay = replay_dir;
     }
     if (!pace.empty()) {
-      config.rig.pace = pace == "fast" ? onboard::ReplayPace::kFast : onboard::ReplayPace::kRecorded;
+      config.rig.pace =
+          pace == "fast" ? onboard::ReplayPace::kFast : onboard::ReplayPace::kRecorded;
     }
     if (!save_path.empty()) config.map.save_path = save_path;
     if (duration) config.rig.duration_s = *duration;

@@ -11,10 +11,10 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "semap/sim/drive_simulator.hpp"
 #include "semap/perception/palette_segmenter.hpp"
-#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
+#include "semap/sim/camera.hpp"
+#include "semap/sim/drive_simulator.hpp"
 #include "semap/sim/world.hpp"
 
 namespace {

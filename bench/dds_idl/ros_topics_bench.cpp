@@ -25,12 +25,12 @@
 #include <vector>
 
 #include "child_pipe.hpp"
-#include "semap/onboard/costmap_output.hpp"
-#include "semap/onboard/mapping_stage.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/dds_idl/reader.hpp"
 #include "semap/dds_idl/topic_names.hpp"
+#include "semap/onboard/costmap_output.hpp"
+#include "semap/onboard/mapping_stage.hpp"
 #include "synthetic_lidar.hpp"
 
 namespace sd = semap::dds_idl;

@@ -11,8 +11,8 @@
 #include "semap/estimation/oxts_writer.hpp"
 #include "semap/map_io/semantic_kitti_io.hpp"
 #include "semap/perception/lidar_projection.hpp"
-#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
+#include "semap/sim/camera.hpp"
 
 namespace semap::bench {
 
@@ -90,7 +90,7 @@ cv::Mat render_labels(const sim::SimWorld& world, const Eigen::Isometry3f& world
 
 // The simulated colour camera with image_02's pinhole (P_rect_02's left 3x3; no skew).
 sim::SimCamera kitti_colour_camera(const perception::KittiCameraCalibration& calib,
-                                          std::uint64_t seed) {
+                                   std::uint64_t seed) {
   sim::SimCameraOptions options;
   options.intrinsics.width = calib.image_size.width;
   options.intrinsics.height = calib.image_size.height;
@@ -116,7 +116,7 @@ void write_text(const fs::path& path, const std::string& text) {
 }  // namespace
 
 sim::SimWorld sim_kitti_raw_world(const SimKittiRawDrive& drive,
-                                         const SimKittiRawOptions& options) {
+                                  const SimKittiRawOptions& options) {
   sim::SimWorldOptions world;
   world.seed = options.seed;
   return sim::SimWorld(drive.path, world);

@@ -29,12 +29,12 @@ struct SimKittiRawOptions {
 
 // What the writer produced, for checks against the truth.
 struct SimKittiRawDrive {
-  std::filesystem::path calib_dir;        // <root>/2011_09_26 with the three calibration files
-  std::filesystem::path drive_dir;        // <calib_dir>/2011_09_26_drive_0001_sync
-  std::filesystem::path labels_dir;       // <drive_dir>/labels_02: 8-bit map class ids per scan
-  std::filesystem::path image_dir;        // <drive_dir>/image_02/data (with colour_images)
-  estimation::DriveData simulation;  // the 100 Hz truth and IMU the packets came from
-  std::vector<Eigen::Vector3d> path;      // world path of the street (ENU, metres)
+  std::filesystem::path calib_dir;    // <root>/2011_09_26 with the three calibration files
+  std::filesystem::path drive_dir;    // <calib_dir>/2011_09_26_drive_0001_sync
+  std::filesystem::path labels_dir;   // <drive_dir>/labels_02: 8-bit map class ids per scan
+  std::filesystem::path image_dir;    // <drive_dir>/image_02/data (with colour_images)
+  estimation::DriveData simulation;   // the 100 Hz truth and IMU the packets came from
+  std::vector<Eigen::Vector3d> path;  // world path of the street (ENU, metres)
   std::size_t scans = 0;
 };
 
@@ -50,6 +50,6 @@ SimKittiRawDrive write_sim_kitti_raw_drive(const std::filesystem::path& root,
 // The street of a written drive (the same world the scans were cast in), z = 0 on the ground;
 // a map point p (ENU of the first packet) lies at p + (0, 0, imu_height_m) in it.
 sim::SimWorld sim_kitti_raw_world(const SimKittiRawDrive& drive,
-                                         const SimKittiRawOptions& options = {});
+                                  const SimKittiRawOptions& options = {});
 
 }  // namespace semap::bench

@@ -10,9 +10,9 @@
 #include <opencv2/core/mat.hpp>
 #include <vector>
 
-#include "semap/onboard/perception_config.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/estimation/pose_history.hpp"
+#include "semap/onboard/perception_config.hpp"
 
 namespace semap::bench {
 

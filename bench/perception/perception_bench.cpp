@@ -20,16 +20,17 @@
 #include <vector>
 
 #include "bench_inputs.hpp"
+#include "semap/drivers/frame_convert.hpp"
+#include "semap/drivers/jpeg_decoder.hpp"
+#include "semap/mapping/cloud_transform.hpp"
 #include "semap/onboard/mapping_stage.hpp"
 #include "semap/onboard/perception_stage.hpp"
 #include "semap/onboard/segmenter_factory.hpp"
-#include "semap/drivers/frame_convert.hpp"
-#include "semap/drivers/jpeg_decoder.hpp"
+#include "semap/onboard/shared_pose_history.hpp"
 #include "semap/perception/depth_cloud.hpp"
 #include "semap/perception/onnx_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 #include "semap/perception/sim_classes.hpp"
-#include "semap/onboard/shared_pose_history.hpp"
 
 namespace {
 
@@ -136,7 +137,7 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
   common::LabeledCloud world;
   row("posing: SharedPoseHistory::at + to world (stride 1)", bench::time_ms(n, [&](int i) {
         const auto lookup = poses.at(common::Stamp::from_seconds((i + 0.37) / kCameraHz));
-        world = onboard::to_world(clouds[0], lookup.pose);
+        world = semap::mapping::transform_cloud(clouds[0], lookup.pose.world_from_body());
       }));
 
   tbb::task_arena arena(o.threads);
@@ -144,7 +145,8 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
     semap::mapping::SemanticMap map(config.map.params);
     const auto s = bench::time_ms(n, [&](int i) {
       const double t = i / kCameraHz;
-      common::LabeledCloud cloud = onboard::to_world(clouds[stride - 1], bench::circle_pose(t, {}));
+      common::LabeledCloud cloud = semap::mapping::transform_cloud(
+          clouds[stride - 1], bench::circle_pose(t, {}).world_from_body());
       arena.execute([&] { map.insert(cloud, cloud.origin); });
     });
     const auto stats = map.stats();

@@ -22,15 +22,16 @@ bool valid_covariance(const Matrix3d& c) {
 }
 }  // namespace
 
-std::unique_ptr<NavFilter> make_filter(FilterKind kind, const FilterParams& params) {
+std::unique_ptr<NavFilter> make_filter(FilterKind kind, const FilterParams& params,
+                                       int covariance_window) {
   if (kind == FilterKind::kQuaternionEskf) return std::make_unique<QuaternionEskf>(params);
-  return std::make_unique<LeftInekf>(params);
+  return std::make_unique<LeftInekf>(params, covariance_window);
 }
 
 Estimator::Estimator(const EstimatorConfig& config)
     : config_(config),
       gate2_(chi_square_quantile(config.gating_probability, 3.0)),
-      filter_(make_filter(config.filter, config.params)),
+      filter_(make_filter(config.filter, config.params, config.covariance_window)),
       validator_(config.imu_limits),
       gnss_buffer_(config.gnss_buffer),
       history_(config.history) {

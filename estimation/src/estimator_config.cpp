@@ -41,6 +41,8 @@ EstimatorConfig load_estimator_config(const common::ConfigSection& s) {
   c.filter = s.get_choice("filter", "inekf", {"inekf", "eskf"}) == "eskf"
                  ? FilterKind::kQuaternionEskf
                  : FilterKind::kLeftInekf;
+  c.covariance_window =
+      static_cast<int>(s.get_in_range("covariance_window", c.covariance_window, 1, 1024));
   auto& n = c.params.noise;
   n.gyro_noise = per_axis(s, "gyro_noise", n.gyro_noise, 1.0);
   n.accel_noise = per_axis(s, "accel_noise", n.accel_noise, 10.0);

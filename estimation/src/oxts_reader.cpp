@@ -217,7 +217,7 @@ OxtsData read_oxts_folder(const std::filesystem::path& dir) {
 }
 
 DriveData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
-                              OxtsGnssNoise noise) {
+                         OxtsGnssNoise noise) {
   DriveData out;
   if (data.records.empty()) return out;
   const auto& first = data.records.front();

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "semap/onboard/segmenter_factory.hpp"
 #include "semap/common/config.hpp"
 #include "semap/drivers/driver_config.hpp"
+#include "semap/onboard/segmenter_factory.hpp"
 
 namespace semap::onboard {
 
@@ -250,9 +250,8 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
 void check_paths(const OnboardConfig& config, const std::filesystem::path& config_file) {
   if (config.dds.enabled && !config.dds.cyclone_config.empty() &&
       !std::filesystem::is_regular_file(config.dds.cyclone_config)) {
-    throw common::ConfigError(config_file.string() +
-                              ": dds.config: " + config.dds.cyclone_config.string() +
-                              ": no such file");
+    throw common::ConfigError(config_file.string() + ": dds.config: " +
+                              config.dds.cyclone_config.string() + ": no such file");
   }
   if (const auto dir = std::filesystem::path(config.map.save_path).parent_path(); !dir.empty()) {
     std::error_code error;

@@ -6,6 +6,7 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/drivers/frame_convert.hpp"
+#include "semap/mapping/cloud_transform.hpp"
 #include "semap/perception/depth_cloud.hpp"
 #include "semap/perception/stereo_depth.hpp"
 
@@ -21,15 +22,6 @@ std::string frame_name(const common::ImageFrame& f) {
 }
 
 }  // namespace
-
-common::LabeledCloud to_world(common::LabeledCloud cloud, const estimation::StampedPose& pose) {
-  Eigen::Isometry3f world_from_body = Eigen::Isometry3f::Identity();
-  world_from_body.linear() = pose.orientation.toRotationMatrix().cast<float>();
-  world_from_body.translation() = pose.position.cast<float>();
-  for (auto& p : cloud.points) p = world_from_body * p;
-  cloud.origin = world_from_body * cloud.origin;
-  return cloud;
-}
 
 PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& depth,
                                  std::unique_ptr<perception::Segmenter> segmenter,
@@ -247,7 +239,8 @@ bool PerceptionStage::pose_clouds() {
       unposed_.pop_front();
       continue;
     }
-    common::LabeledCloud cloud = to_world(std::move(unposed_.front().cloud), lookup.pose);
+    common::LabeledCloud cloud =
+        mapping::transform_cloud(std::move(unposed_.front().cloud), lookup.pose.world_from_body());
     const common::Stamp stamp = cloud.stamp;
     stage_.figures().points += cloud.size();
     unposed_.pop_front();

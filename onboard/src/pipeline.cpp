@@ -6,6 +6,7 @@
 #include <string>
 
 #include "semap/common/logging.hpp"
+#include "semap/mapping/smap_io.hpp"
 #include "semap/onboard/run_summary.hpp"
 #include "semap/onboard/segmenter_factory.hpp"
 
@@ -95,8 +96,8 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
   if (const auto frame = mapping_->map_frame()) {
     estimation.estimator.anchor = checkpoint_anchor(*frame, config_.estimator.anchor);
     log->info("map frame anchored at {:.8f}, {:.8f}, {:.2f} (from the checkpoint)",
-              estimation.estimator.anchor->latitude_deg,
-              estimation.estimator.anchor->longitude_deg, estimation.estimator.anchor->altitude_m);
+              estimation.estimator.anchor->latitude_deg, estimation.estimator.anchor->longitude_deg,
+              estimation.estimator.anchor->altitude_m);
   }
   estimation_ = std::make_unique<EstimationStage>(estimation, imu_ring_, gnss_ring_, poses_,
                                                   [this](const PoseOutput& pose) {
@@ -174,6 +175,11 @@ bool Pipeline::has_taken(const HandedOver& handed) const {
   const auto done = p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose;
   return p.frames == handed.colour_frames && done == p.frames &&
          mapping_->stats().scans + drops(cloud_ring_) == p.clouds;
+}
+
+void Pipeline::save_map(const std::filesystem::path& path) {
+  mapping::write_smap(path, map().layers());
+  common::logger("onboard")->info("map saved to {}", path.string());
 }
 
 std::optional<PerceptionStageStats> Pipeline::perception() const {

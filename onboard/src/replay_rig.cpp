@@ -5,8 +5,8 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "semap/onboard/rig_clock.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/onboard/rig_clock.hpp"
 #include "semap/onboard/stream_recorder.hpp"
 
 namespace semap::onboard {
@@ -82,9 +82,7 @@ ReplayRig::ReplayRig(const OnboardConfig& config, const SensorRings& rings)
 
 ReplayRig::~ReplayRig() { stop(); }
 
-void ReplayRig::set_taps(RawTaps) {
-  throw std::runtime_error("a replay cannot be recorded again");
-}
+void ReplayRig::set_taps(RawTaps) { throw std::runtime_error("a replay cannot be recorded again"); }
 
 void ReplayRig::start() {
   drivers_.start();

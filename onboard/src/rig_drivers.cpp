@@ -29,9 +29,10 @@ void RigDrivers::add_depth(const drivers::CameraConfig& config,
 void RigDrivers::set_taps(const RawTaps& taps) {
   if (gnss_ && taps.gnss_bytes) gnss_->set_byte_tap(taps.gnss_bytes);
   if (imu_ && taps.can_frame) {
-    imu_->set_frame_tap([tap = taps.can_frame](const drivers::CanRxFrame& rx, drivers::CanRead read) {
-      tap(rx.stamp, rx.frame, read == drivers::CanRead::kError);
-    });
+    imu_->set_frame_tap(
+        [tap = taps.can_frame](const drivers::CanRxFrame& rx, drivers::CanRead read) {
+          tap(rx.stamp, rx.frame, read == drivers::CanRead::kError);
+        });
   }
 }
 
@@ -61,9 +62,9 @@ std::vector<dds_idl::DriverCountersData> RigDrivers::health() const {
 void RigDrivers::summary(std::vector<std::string>& lines) const {
   if (gnss_) {
     const auto g = gnss_->stats();
-    lines.push_back(fmt::format(
-        "gnss driver      : {} fixes, {} bytes, {} checksum failures, {} reconnects", g.frames,
-        g.bytes, g.checksum_failures, g.reconnects));
+    lines.push_back(
+        fmt::format("gnss driver      : {} fixes, {} bytes, {} checksum failures, {} reconnects",
+                    g.frames, g.bytes, g.checksum_failures, g.reconnects));
   }
   if (imu_) {
     const auto i = imu_->stats();

@@ -5,24 +5,24 @@
 namespace semap::onboard {
 
 void estimation_summary(const EstimationStageStats& est, std::vector<std::string>& lines) {
-  lines.push_back(fmt::format(
-      "estimation       : {} IMU samples, {} GNSS fixes ({} applied, {} gated out), "
-      "initialised={}",
-      est.imu_samples, est.gnss_fixes, est.estimator.gnss_applied, est.estimator.gnss_rejected,
-      est.initialised ? "yes" : "no"));
+  lines.push_back(
+      fmt::format("estimation       : {} IMU samples, {} GNSS fixes ({} applied, {} gated out), "
+                  "initialised={}",
+                  est.imu_samples, est.gnss_fixes, est.estimator.gnss_applied,
+                  est.estimator.gnss_rejected, est.initialised ? "yes" : "no"));
 }
 
 void perception_summary(const PerceptionStage& perception, std::vector<std::string>& lines) {
   const auto p = perception.stats();
   const auto lat = perception.latency().percentiles();
-  lines.push_back(fmt::format(
-      "perception       : {} frames, {} clouds mapped ({} points), {} passed over, "
-      "{} unpaired, {} bad, {} without a pose; segment mean {:.1f} ms max {:.1f} ms; "
-      "latency p50 {:.1f} ms p99 {:.1f} ms",
-      p.frames, p.clouds, p.points, p.skipped, p.unpaired, p.bad_frames, p.without_pose,
-      p.clouds ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
-      1e3 * p.segment_seconds_max, static_cast<double>(lat.p50_ms),
-      static_cast<double>(lat.p99_ms)));
+  lines.push_back(
+      fmt::format("perception       : {} frames, {} clouds mapped ({} points), {} passed over, "
+                  "{} unpaired, {} bad, {} without a pose; segment mean {:.1f} ms max {:.1f} ms; "
+                  "latency p50 {:.1f} ms p99 {:.1f} ms",
+                  p.frames, p.clouds, p.points, p.skipped, p.unpaired, p.bad_frames, p.without_pose,
+                  p.clouds ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
+                  1e3 * p.segment_seconds_max, static_cast<double>(lat.p50_ms),
+                  static_cast<double>(lat.p99_ms)));
   lines.push_back(fmt::format(
       "pixels dropped   : {} no depth, {} out of range, {} no label, {} low confidence",
       p.dropped.no_depth, p.dropped.out_of_range, p.dropped.no_label, p.dropped.low_confidence));
@@ -30,13 +30,13 @@ void perception_summary(const PerceptionStage& perception, std::vector<std::stri
 
 void mapping_summary(const MappingStageStats& map, const std::filesystem::path& checkpoint_path,
                      double memory_radius_m, std::vector<std::string>& lines) {
-  lines.push_back(fmt::format(
-      "mapping          : {} scans, {} points, insert mean {:.1f} ms max {:.1f} ms, "
-      "{} blocks, {} observed cells, {:.1f} bytes/cell",
-      map.scans, map.points,
-      map.scans ? 1e3 * map.insert_seconds_total / static_cast<double>(map.scans) : 0.0,
-      1e3 * map.insert_seconds_max, map.map.blocks, map.map.observed_cells,
-      map.map.bytes_per_cell()));
+  lines.push_back(
+      fmt::format("mapping          : {} scans, {} points, insert mean {:.1f} ms max {:.1f} ms, "
+                  "{} blocks, {} observed cells, {:.1f} bytes/cell",
+                  map.scans, map.points,
+                  map.scans ? 1e3 * map.insert_seconds_total / static_cast<double>(map.scans) : 0.0,
+                  1e3 * map.insert_seconds_max, map.map.blocks, map.map.observed_cells,
+                  map.map.bytes_per_cell()));
   if (map.checkpoint.checkpoints > 0 || map.checkpoint.resumed_scans > 0) {
     lines.push_back(fmt::format(
         "map checkpoint   : {}, {} checkpoints, {} blocks written, write max {:.1f} ms, "
@@ -54,11 +54,11 @@ void mapping_summary(const MappingStageStats& map, const std::filesystem::path& 
 
 void dds_summary(const DdsOutputs& dds, std::vector<std::string>& lines) {
   const auto m = dds.map_counters();
-  lines.push_back(fmt::format(
-      "dds              : {} odometry samples, {} block samples in {} rounds, "
-      "{} map clouds, {} cloud updates ({} points), {} health reports",
-      dds.odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
-      m.cloud_updates_written, m.cloud_update_points, dds.health_written()));
+  lines.push_back(
+      fmt::format("dds              : {} odometry samples, {} block samples in {} rounds, "
+                  "{} map clouds, {} cloud updates ({} points), {} health reports",
+                  dds.odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
+                  m.cloud_updates_written, m.cloud_update_points, dds.health_written()));
   if (const auto c = dds.costmap_counters()) {
     lines.push_back(fmt::format(
         "costmap          : {} grids ({} rebuilt around the robot), {} updates, last round "

@@ -101,10 +101,8 @@ void StreamRecorder::flush() {
 
 void StreamRecorder::attach(Pipeline& pipeline) {
   pipeline.rig().set_taps(
-      {.can_frame =
-           [this](common::Stamp stamp, const SemapCanFrame& frame, bool error_frame) {
-             can_frame(stamp, frame, error_frame);
-           },
+      {.can_frame = [this](common::Stamp stamp, const SemapCanFrame& frame,
+                           bool error_frame) { can_frame(stamp, frame, error_frame); },
        .gnss_bytes = [this](common::Stamp stamp,
                             std::span<const std::uint8_t> bytes) { gnss_bytes(stamp, bytes); }});
   pipeline.attach(*this);

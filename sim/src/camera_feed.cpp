@@ -49,9 +49,9 @@ cv::Mat paint_classes(const cv::Mat& train_ids) {
 
 }  // namespace
 
-SimCameraFeed::SimCameraFeed(const sim::SimWorld& world,
-                             const sim::SimCameraOptions& camera, SimCameraImage image,
-                             float depth_scale, common::SpscRing<common::ImageFrame>& colour_ring,
+SimCameraFeed::SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOptions& camera,
+                             SimCameraImage image, float depth_scale,
+                             common::SpscRing<common::ImageFrame>& colour_ring,
                              common::SpscRing<common::ImageFrame>& depth_ring,
                              SimCameraOutput output)
     : world_(world),
@@ -145,8 +145,8 @@ void SimCameraFeed::run(std::stop_token stop) {
   }
 }
 
-void SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp,
-                            std::uint32_t sequence, std::stop_token stop) {
+void SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
+                            std::stop_token stop) {
   const cv::Mat colour = image_ == SimCameraImage::kRgb ? frame.bgr : paint_classes(frame.labels);
   if (!output_.device) {
     colour_ring_.try_push(to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));

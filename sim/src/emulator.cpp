@@ -210,7 +210,8 @@ void Emulator::emit_gnss(const common::GnssFix& truth) {
   if (f.garbage_max_bytes > 0 && chance(f.garbage)) send_garbage();
   const bool truncate = chance(f.truncate);
   if (config_.gnss_protocol == firmware_bridge::GnssProtocol::kNmea) {
-    const std::vector<std::string> sentences = firmware_bridge::encode_nmea_epoch(fix, utc_ms, config_.talker);
+    const std::vector<std::string> sentences =
+        firmware_bridge::encode_nmea_epoch(fix, utc_ms, config_.talker);
     const std::size_t cut =
         truncate ? std::uniform_int_distribution<std::size_t>(0, sentences.size() - 1)(rng_)
                  : sentences.size();

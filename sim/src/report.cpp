@@ -79,21 +79,21 @@ std::string number(std::optional<double> v, int decimals = 4) {
 }
 
 // {"road": 0.98, ...} over map classes 1..K-1, null for those the truth never has.
-std::string per_class(const ClassConfusion& confusion) {
+std::string per_class(const mapping::ConfusionMatrix& confusion) {
   std::string out = "{";
   for (int c = 1; c < kSimMapClasses; ++c) {
     out += (c > 1 ? ", \"" : "\"") + std::string(kSimMapClassTable[c].name) +
-           "\": " + number(confusion.iou(c));
+           "\": " + number(confusion.iou_if_present(c));
   }
   return out + "}";
 }
 
 // Rows are true classes (free first), columns predicted classes then "no label".
-std::string confusion_rows(const ClassConfusion& confusion) {
+std::string confusion_rows(const mapping::ConfusionMatrix& confusion) {
   std::string out = "[";
-  for (int t = 0; t < ClassConfusion::K; ++t) {
+  for (int t = 0; t < kSimMapClasses; ++t) {
     out += t ? ", [" : "[";
-    for (int p = 0; p <= ClassConfusion::K; ++p) {
+    for (int p = 0; p <= kSimMapClasses; ++p) {
       out += (p ? ", " : "") + std::to_string(confusion.count(t, p));
     }
     out += "]";
@@ -113,50 +113,6 @@ std::optional<PoseVsTruth> pose_vs_truth(const SimRig& rig,
   const Eigen::Vector3d anchor = sim_frame.to_enu(*s.anchor);
   return PoseVsTruth{s.latest->position + anchor - s.anchor_offset, truth->state.position,
                      s.latest->stamp};
-}
-
-void ClassConfusion::add(std::uint16_t truth, std::uint16_t predicted, std::uint64_t count) {
-  if (truth >= K) return;
-  counts_[truth][std::min<std::size_t>(predicted, K)] += count;
-}
-
-std::optional<double> ClassConfusion::iou(int c) const {
-  const std::uint64_t row = truth_count(c);
-  if (row == 0) return std::nullopt;
-  std::uint64_t column = 0;
-  for (int i = 0; i < K; ++i) column += counts_[i][c];
-  const auto hit = counts_[c][c];
-  return static_cast<double>(hit) / static_cast<double>(row + column - hit);
-}
-
-double ClassConfusion::mean_iou() const {
-  double sum = 0.0;
-  int n = 0;
-  for (int c = 1; c < K; ++c) {
-    if (const auto v = iou(c)) {
-      sum += *v;
-      ++n;
-    }
-  }
-  return n ? sum / n : std::numeric_limits<double>::quiet_NaN();
-}
-
-std::uint64_t ClassConfusion::truth_count(int c) const {
-  std::uint64_t n = 0;
-  for (const auto v : counts_[c]) n += v;
-  return n;
-}
-
-std::uint64_t ClassConfusion::total() const {
-  std::uint64_t n = 0;
-  for (int c = 0; c < K; ++c) n += truth_count(c);
-  return n;
-}
-
-ClassConfusion ClassConfusion::without_free() const {
-  ClassConfusion out = *this;
-  out.counts_[0] = {};
-  return out;
 }
 
 SimReport::SimReport(const SimRig& rig, std::filesystem::path dir)
@@ -184,8 +140,9 @@ void SimReport::on_estimate(const onboard::EstimationStageStats& s) {
 
 void SimReport::summary(std::vector<std::string>& lines) const {
   if (!accuracy_.any()) return;
-  lines.push_back(fmt::format("pose vs truth    : position RMSE {:.3f} m, max {:.3f} m over {} checks",
-                              accuracy_.rmse(), accuracy_.max(), accuracy_.count()));
+  lines.push_back(
+      fmt::format("pose vs truth    : position RMSE {:.3f} m, max {:.3f} m over {} checks",
+                  accuracy_.rmse(), accuracy_.max(), accuracy_.count()));
 }
 
 std::filesystem::path SimReport::write(onboard::Pipeline& pipeline, const std::string& segmenter,
@@ -202,26 +159,26 @@ std::filesystem::path SimReport::write(onboard::Pipeline& pipeline, const std::s
 }
 
 void SimReport::on_segmentation(std::uint32_t sequence, common::Stamp, const cv::Mat& bgr,
-                        const perception::Segmentation& seg) {
+                                const perception::Segmentation& seg) {
   if (dir_.empty()) return;
   static const auto to_map_class = train_id_to_map_class();
   const auto truth = rig_.camera().true_labels(sequence);
   if (!truth || truth->size() != seg.labels.size()) return;  // no longer kept
   // Per (true, predicted) pair over the frame, then into the matrix: sky pixels are not
   // scored, pixels the segmenter left unlabelled count as misses.
-  std::array<std::array<std::uint64_t, ClassConfusion::K + 1>, ClassConfusion::K> frame{};
+  std::array<std::array<std::uint64_t, kSimMapClasses + 1>, kSimMapClasses> frame{};
   for (int v = 0; v < truth->rows; ++v) {
     const auto* t = truth->ptr<std::uint8_t>(v);
     const auto* p = seg.labels.ptr<std::uint16_t>(v);
     for (int u = 0; u < truth->cols; ++u) {
       const std::uint16_t c = to_map_class[t[u]];
-      if (c >= ClassConfusion::K) continue;
-      ++frame[c][std::min<std::uint16_t>(p[u], ClassConfusion::K)];
+      if (c >= kSimMapClasses) continue;
+      ++frame[c][std::min<std::uint16_t>(p[u], kSimMapClasses)];
     }
   }
   std::lock_guard lock(mutex_);
-  for (std::uint16_t c = 0; c < ClassConfusion::K; ++c) {
-    for (std::uint16_t j = 0; j <= ClassConfusion::K; ++j) {
+  for (std::uint16_t c = 0; c < kSimMapClasses; ++c) {
+    for (std::uint16_t j = 0; j <= kSimMapClasses; ++j) {
       if (frame[c][j]) pixels_.add(c, j, frame[c][j]);
     }
   }
@@ -238,9 +195,9 @@ void SimReport::sample_pose(const onboard::EstimationStageStats& s) {
   track_.emplace_back(pair->truth.head<2>(), pair->estimate.head<2>());
 }
 
-ClassConfusion SimReport::map_confusion(const mapping::SemanticMap& map,
-                                        const onboard::EstimationStageStats& final) const {
-  ClassConfusion confusion;
+mapping::ConfusionMatrix SimReport::map_confusion(
+    const mapping::SemanticMap& map, const onboard::EstimationStageStats& final) const {
+  mapping::ConfusionMatrix confusion(kSimMapClasses);
   if (!final.anchor) return confusion;
   const estimation::LocalEnu sim_frame(rig_.data().origin);
   const Eigen::Vector3f map_to_sim =
@@ -366,12 +323,11 @@ std::filesystem::path SimReport::write(const RunFigures& run, const mapping::Sem
   write_camera_png();
   write_trajectory_png(run.pose_rmse_m);
   write_truth_csv(final);
-  const ClassConfusion cells = map_confusion(map, final);
-  ClassConfusion pixels;
-  {
+  const mapping::ConfusionMatrix cells = map_confusion(map, final);
+  const mapping::ConfusionMatrix pixels = [&] {
     std::lock_guard lock(mutex_);
-    pixels = pixels_;
-  }
+    return pixels_;
+  }();
   std::ostringstream drops;
   for (std::size_t i = 0; i < run.ring_drops.size(); ++i) {
     drops << (i ? ", \"" : "\"") << run.ring_drops[i].first << "\": " << run.ring_drops[i].second;
@@ -383,11 +339,12 @@ std::filesystem::path SimReport::write(const RunFigures& run, const mapping::Sem
   json << "{\n"
        << "  \"segmenter\": \"" << run.segmenter << "\",\n"
        << "  \"pose_rmse_m\": " << number(run.pose_rmse_m, 3) << ",\n"
-       << "  \"segmentation_miou\": " << number(pixels.mean_iou()) << ",\n"
+       << "  \"segmentation_miou\": " << number(pixels.mean_iou_of_present(1)) << ",\n"
        << "  \"segmentation_iou_per_class\": " << per_class(pixels) << ",\n"
-       << "  \"map_miou\": " << number(cells.mean_iou()) << ",\n"
+       << "  \"map_miou\": " << number(cells.mean_iou_of_present(1)) << ",\n"
        << "  \"map_iou_per_class\": " << per_class(cells) << ",\n"
-       << "  \"map_miou_surface_cells\": " << number(cells.without_free().mean_iou()) << ",\n"
+       << "  \"map_miou_surface_cells\": "
+       << number(cells.without_true_class(0).mean_iou_of_present(1)) << ",\n"
        << "  \"map_cells\": {\"occupied\": " << cells.total()
        << ", \"off_surface\": " << cells.truth_count(0) << "},\n"
        << "  \"map_confusion_truth_by_predicted\": " << confusion_rows(cells) << ",\n"

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "semap/onboard/rig_clock.hpp"
 #include "semap/common/logging.hpp"
-#include "semap/drivers/frame_convert.hpp"
 #include "semap/drivers/can_socket.hpp"
+#include "semap/drivers/frame_convert.hpp"
+#include "semap/onboard/rig_clock.hpp"
 #include "semap/sim/sensor_source.hpp"
 
 namespace semap::sim {
@@ -68,12 +68,12 @@ SimRig::SimRig(const onboard::OnboardConfig& config, const SimRigConfig& sim,
     output.period_s = 1.0 / c.fps;
     output.tolerance_s = config.depth.sync_tolerance_s;
     common::logger("sim_rig")->info("camera frames to {} ({}): BGR24 {}x{}, {:.0f} ms ahead",
-                                    sim.camera_output, output.device->card(), c.width,
-                                    c.height, 1e3 * (output.period_s - output.tolerance_s));
+                                    sim.camera_output, output.device->card(), c.width, c.height,
+                                    1e3 * (output.period_s - output.tolerance_s));
   }
-  camera_ = std::make_unique<SimCameraFeed>(world_, camera, sim.camera_image,
-                                            config.depth.depth_scale, rings.colour, rings.depth,
-                                            std::move(output));
+  camera_ =
+      std::make_unique<SimCameraFeed>(world_, camera, sim.camera_image, config.depth.depth_scale,
+                                      rings.colour, rings.depth, std::move(output));
   // Shown on a V4L2 output, the colour frames come back through the camera's driver.
   if (!sim.camera_output.empty()) drivers_.add_camera(config.camera.driver, rings.colour);
   sim::EmulatorConfig emu;

@@ -31,7 +31,8 @@ onboard::RigKeys sim_rig_keys(SimRigConfig& out) {
   return [&out](const ConfigSection& rig, const ConfigSection& root, onboard::OnboardConfig& c) {
     read_keys(rig, out);
     if (c.rig.kind == onboard::RigKind::kSim && c.depth.source != onboard::DepthSource::kAligned) {
-      root.section_or_empty("depth").reject("source", "the simulated rig renders aligned depth only");
+      root.section_or_empty("depth").reject("source",
+                                            "the simulated rig renders aligned depth only");
     }
     if (out.camera_output.empty()) return;
     if (c.rig.kind != onboard::RigKind::kSim) {

@@ -34,7 +34,8 @@ struct Bounds {
 
 }  // namespace
 
-SimScreenBins::SimScreenBins(std::span<const SimSolid> solids, const perception::PinholeIntrinsics& k,
+SimScreenBins::SimScreenBins(std::span<const SimSolid> solids,
+                             const perception::PinholeIntrinsics& k,
                              const Eigen::Isometry3f& world_from_optical, float max_range) {
   tiles_x_ = (k.width + kTile - 1) / kTile;
   tiles_y_ = (k.height + kTile - 1) / kTile;

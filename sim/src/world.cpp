@@ -60,8 +60,9 @@ std::optional<SimHit> SimWorld::cast_ground(const Eigen::Vector3f& o, const Eige
   const Eigen::Vector3f p0 = o + t0 * d;
   const auto at0 = road_.at(p0.x(), p0.y());
   if (o.z() <= kerb) {
-    return at0.distance < edge ? hit(t0, Eigen::Vector3f::UnitZ(), perception::sim_train_id::kRoad, at0)
-                               : std::nullopt;
+    return at0.distance < edge
+               ? hit(t0, Eigen::Vector3f::UnitZ(), perception::sim_train_id::kRoad, at0)
+               : std::nullopt;
   }
   // p1 is `shift` away from p0 in plan and the distance is 1-Lipschitz: p0 well inside the
   // road settles it without a second query.
@@ -74,7 +75,8 @@ std::optional<SimHit> SimWorld::cast_ground(const Eigen::Vector3f& o, const Eige
   if (at1.distance >= edge) {
     return hit(t1, Eigen::Vector3f::UnitZ(), ground_class(at1.distance), at1);
   }
-  if (at0.distance < edge) return hit(t0, Eigen::Vector3f::UnitZ(), perception::sim_train_id::kRoad, at0);
+  if (at0.distance < edge)
+    return hit(t0, Eigen::Vector3f::UnitZ(), perception::sim_train_id::kRoad, at0);
   float lo = t1;
   float hi = t0;
   for (int i = 0; i < 12; ++i) {

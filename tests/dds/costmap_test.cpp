@@ -9,12 +9,12 @@
 #include <optional>
 #include <vector>
 
-#include "semap/onboard/costmap_output.hpp"
 #include "dds_fixture.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/reader.hpp"
 #include "semap/dds_idl/topic_names.hpp"
 #include "semap/mapping/semantic_map.hpp"
+#include "semap/onboard/costmap_output.hpp"
 
 namespace semap::dds_idl::testing {
 namespace {

@@ -6,10 +6,10 @@
 #include <random>
 
 #include "dds_fixture.hpp"
-#include "semap/onboard/mapping_stage.hpp"
 #include "semap/dds_idl/map_client.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/mapping/semantic_map.hpp"
+#include "semap/onboard/mapping_stage.hpp"
 
 namespace semap::dds_idl::testing {
 namespace {

@@ -10,9 +10,9 @@
 #include <sstream>
 
 #include "dds_fixture.hpp"
+#include "ros2_node/map_digest.hpp"
 #include "semap/onboard/dds_outputs.hpp"
 #include "semap/onboard/mapping_stage.hpp"
-#include "ros2_node/map_digest.hpp"
 
 namespace semap::dds_idl::testing {
 namespace {

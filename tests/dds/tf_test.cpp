@@ -7,10 +7,10 @@
 #include <optional>
 
 #include "dds_fixture.hpp"
-#include "semap/onboard/dds_outputs.hpp"
-#include "semap/onboard/mapping_stage.hpp"
 #include "semap/dds_idl/reader.hpp"
 #include "semap/dds_idl/topic_names.hpp"
+#include "semap/onboard/dds_outputs.hpp"
+#include "semap/onboard/mapping_stage.hpp"
 
 namespace semap::dds_idl::testing {
 namespace {

@@ -174,14 +174,21 @@ costmap=$(grep '^costmap ' "$work/onboard.log" || true)
 grids=$(awk '{print $3}' <<<"$costmap")
 num "costmap grids" "$grids"
 [[ "$grids" -ge 5 ]] || fail "costmap: '$costmap'"
+# Stopping drains every ring through its stage: each colour frame taken became a cloud or is
+# counted with its reason, and each cloud is in the map or counted as dropped by the cloud ring
+# (which drops the oldest rather than stall perception).
+perception=$(grep '^perception *: ' "$work/onboard.log" || true)
+read -r frames posed skipped unpaired bad unposed < <(sed -n 's/^perception *: \([0-9]*\) frames, \([0-9]*\) clouds mapped ([0-9]* points), \([0-9]*\) passed over, \([0-9]*\) unpaired, \([0-9]*\) bad, \([0-9]*\) without a pose.*/\1 \2 \3 \4 \5 \6/p' <<<"$perception")
 scans=$(sed -n 's/^mapping *: \([0-9]*\) scans.*/\1/p' "$work/onboard.log")
-posed=$(sed -n 's/^perception *: [0-9]* frames, \([0-9]*\) clouds mapped.*/\1/p' "$work/onboard.log")
-num "clouds posed" "$posed"
-num "scans" "$scans"
-num "frames mapped" "$mapped"
-[[ "$posed" -eq "$mapped" ]] || fail "perception: $posed clouds, report: $mapped"
-# The cloud ring drops the oldest scan rather than stall perception; allow a few drops.
-[[ $((scans * 10)) -ge $((posed * 9)) ]] || fail "scans $scans, posed $posed"
+cloud_drops=$(sed -n 's/^ring drops *: .*, clouds \([0-9]*\)$/\1/p' "$work/onboard.log")
+for figure in frames posed skipped unpaired bad unposed scans cloud_drops mapped; do
+  num "$figure" "${!figure:-}"
+done
+[[ $((posed + skipped + unpaired + bad + unposed)) -eq "$frames" ]] ||
+  fail "perception: $frames frames but $posed clouds + $skipped + $unpaired + $bad + $unposed lost"
+[[ $((scans + cloud_drops)) -eq "$posed" ]] ||
+  fail "perception made $posed clouds; mapped $scans, the ring dropped $cloud_drops"
+[[ "$mapped" -eq "$scans" ]] || fail "report: $mapped frames mapped, summary: $scans scans"
 field() { # field LINE KIND NAME KEY: the value after "KIND NAME ... KEY" within that entry
   awk -v kind="$2" -v name="$3" -v key="$4" '{
     for (i = 1; i < NF; i++) if ($i == kind && $(i + 1) == name) {

@@ -12,10 +12,10 @@
 
 #include "hil_env.hpp"
 #include "semap/drivers/gnss_driver.hpp"
-#include "semap/sim/constant_turn_source.hpp"
-#include "semap/sim/emulator.hpp"
 #include "semap/firmware_bridge/nmea.h"
 #include "semap/firmware_bridge/ubx.h"
+#include "semap/sim/constant_turn_source.hpp"
+#include "semap/sim/emulator.hpp"
 
 namespace semap::drivers {
 namespace {
@@ -74,8 +74,7 @@ class GnssPtyTest : public ::testing::Test {
   }
 
   // 10 s of a 10 Hz receiver, sent 20x faster than real time.
-  static sim::EmulatorStats emulate(int fd, GnssProtocol protocol,
-                                                const sim::FaultConfig& faults) {
+  static sim::EmulatorStats emulate(int fd, GnssProtocol protocol, const sim::FaultConfig& faults) {
     sim::ConstantTurnConfig truth;
     truth.duration_s = 10.0;
     truth.imu_rate_hz = 10.0;  // IMU events are not sent (no CAN fd); keep them few

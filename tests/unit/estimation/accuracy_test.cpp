@@ -9,6 +9,7 @@
 
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/so3.hpp"
+#include "semap/sim/drive_simulator.hpp"
 
 namespace semap::estimation {
 namespace {
@@ -27,10 +28,10 @@ Figures drive(FilterKind kind) {
   options.metrics_after_s = 30.0;  // after the heading has converged from the 17 deg guess
   options.motion_start_s = 2.0;
   for (int run = 0; run < kRuns; ++run) {
-    SimulatorConfig sc;
+    sim::SimulatorConfig sc;
     sc.duration_s = 600.0;
     sc.seed = 100 + static_cast<std::uint64_t>(run);
-    const DriveData data = simulate(sc);
+    const DriveData data = sim::simulate(sc);
     EstimatorConfig ec;
     ec.filter = kind;
     const EvaluationRun r = run_evaluation(data, ec, options);
@@ -65,10 +66,10 @@ TEST(Accuracy, TenMinuteDrive) {
 }
 
 double settle_from_180(FilterKind kind, std::uint64_t seed) {
-  SimulatorConfig sc;
+  sim::SimulatorConfig sc;
   sc.duration_s = 60.0;
   sc.seed = seed;
-  const DriveData data = simulate(sc);
+  const DriveData data = sim::simulate(sc);
   EstimatorConfig ec;
   ec.filter = kind;
   ec.init.yaw_rad = yaw_of(data.truth.front().state.rotation) + std::numbers::pi;

@@ -6,13 +6,13 @@
 
 #include "semap/estimation/estimator_config.hpp"
 #include "semap/estimation/evaluation.hpp"
-#include "semap/sim/drive_simulator.hpp"
 #include "semap/estimation/so3.hpp"
+#include "semap/sim/drive_simulator.hpp"
 
 namespace semap::estimation::test {
 
-inline SimulatorConfig drive(double seconds, std::uint64_t seed = 11) {
-  SimulatorConfig c;
+inline sim::SimulatorConfig drive(double seconds, std::uint64_t seed = 11) {
+  sim::SimulatorConfig c;
   c.duration_s = seconds;
   c.seed = seed;
   return c;

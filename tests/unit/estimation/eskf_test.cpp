@@ -20,7 +20,7 @@ using test::max_position_error_after;
 // GNSS sigma 1 m per axis (1.7 m 3-D): the fused estimate must be well inside that.
 TEST(Eskf, TwoMinuteDriveAccuracy) {
   for (const std::uint64_t seed : {11u, 12u}) {
-    const DriveData data = simulate(drive(120.0, seed));
+    const DriveData data = sim::simulate(drive(120.0, seed));
     EvaluationOptions options;
     options.metrics_after_s = 30.0;
     options.motion_start_s = 2.0;
@@ -37,7 +37,7 @@ TEST(Eskf, TwoMinuteDriveAccuracy) {
 
 // Normal fixes are accepted: at a 0.999 gate a clean drive loses at most a handful.
 TEST(Eskf, AcceptsNormalFixes) {
-  const DriveData data = simulate(drive(90.0));
+  const DriveData data = sim::simulate(drive(90.0));
   const EvaluationRun run =
       run_evaluation(data, heading_known(data, FilterKind::kQuaternionEskf), {});
   EXPECT_LE(run.counters.gnss_rejected, 3u);
@@ -47,9 +47,9 @@ TEST(Eskf, AcceptsNormalFixes) {
 
 // Five fixes 50 m off (0.5 s at 10 Hz) are gated out, and nothing else.
 TEST(Eskf, GatesATransientFiftyMetreJump) {
-  SimulatorConfig sc = drive(90.0);
+  sim::SimulatorConfig sc = drive(90.0);
   sc.jumps.push_back({60.0, 0.5, Vector3d(50.0, 0.0, 0.0)});
-  const DriveData data = simulate(sc);
+  const DriveData data = sim::simulate(sc);
   const EvaluationRun run =
       run_evaluation(data, heading_known(data, FilterKind::kQuaternionEskf), {});
   EXPECT_EQ(run.counters.gnss_rejected, 5u);
@@ -60,12 +60,12 @@ TEST(Eskf, GatesATransientFiftyMetreJump) {
 // A single outlier of 8 m (about 8 sigma) is refused; the same drive without it refuses none
 // of the fixes around it.
 TEST(Eskf, GatesASingleOutlierFix) {
-  SimulatorConfig sc = drive(90.0);
+  sim::SimulatorConfig sc = drive(90.0);
   sc.jumps.push_back({45.0, 0.05, Vector3d(0.0, 8.0, 0.0)});
-  const DriveData data = simulate(sc);
+  const DriveData data = sim::simulate(sc);
   const EvaluationRun with =
       run_evaluation(data, heading_known(data, FilterKind::kQuaternionEskf), {});
-  const DriveData clean_data = simulate(drive(90.0));
+  const DriveData clean_data = sim::simulate(drive(90.0));
   const EvaluationRun clean =
       run_evaluation(clean_data, heading_known(clean_data, FilterKind::kQuaternionEskf), {});
   EXPECT_EQ(with.counters.gnss_rejected, clean.counters.gnss_rejected + 1);

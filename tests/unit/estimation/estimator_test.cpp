@@ -8,8 +8,8 @@
 #include "drive_fixtures.hpp"
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/gnss_reorder_buffer.hpp"
-#include "semap/sim/drive_simulator.hpp"
 #include "semap/estimation/so3.hpp"
+#include "semap/sim/drive_simulator.hpp"
 
 namespace semap::estimation {
 namespace {
@@ -128,9 +128,9 @@ TEST(Estimator, BadInputIsCountedNotFatal) {
 }
 
 TEST(Estimator, GatesATransientFiftyMetreJump) {
-  SimulatorConfig sc = drive(90.0);
+  sim::SimulatorConfig sc = drive(90.0);
   sc.jumps.push_back({60.0, 0.5, Vector3d(50.0, 0.0, 0.0)});
-  const DriveData data = simulate(sc);
+  const DriveData data = sim::simulate(sc);
   const EvaluationRun run = run_evaluation(data, heading_known(data), {});
   EXPECT_EQ(run.counters.gnss_rejected, 5u);  // the five jumped fixes, nothing else
   EXPECT_EQ(run.counters.reanchors, 0u);
@@ -138,9 +138,9 @@ TEST(Estimator, GatesATransientFiftyMetreJump) {
 }
 
 TEST(Estimator, RecoversFromPersistentJumpByReanchoring) {
-  SimulatorConfig sc = drive(120.0);
+  sim::SimulatorConfig sc = drive(120.0);
   sc.jumps.push_back({60.0, 1000.0, Vector3d(50.0, -20.0, 0.0)});
-  const DriveData data = simulate(sc);
+  const DriveData data = sim::simulate(sc);
   const EvaluationRun run = run_evaluation(data, heading_known(data), {});
   EXPECT_EQ(run.counters.reanchors, 1u);
   EXPECT_GE(run.counters.gnss_rejected, 10u);
@@ -151,7 +151,7 @@ TEST(Estimator, RecoversFromPersistentJumpByReanchoring) {
 }
 
 TEST(Estimator, LateFixesAreAppliedInOrderWithinTheImuDelay) {
-  const DriveData data = simulate(drive(40.0));
+  const DriveData data = sim::simulate(drive(40.0));
   EstimatorConfig config = heading_known(data);
   config.anchor = data.origin;
   config.imu_delay_s = 0.2;  // swapped pairs arrive up to 0.15 s late
@@ -191,7 +191,7 @@ TEST(Estimator, LateFixesAreAppliedInOrderWithinTheImuDelay) {
 // that hand over their fixes before the IMU samples they fall between (as the onboard stage
 // does) give exactly the estimate of a feed in stamp order, from initialisation on.
 TEST(Estimator, FixesAheadOfTheImuGiveTheEstimateOfAStampOrderedFeed) {
-  const DriveData data = simulate(drive(40.0));
+  const DriveData data = sim::simulate(drive(40.0));
   EstimatorConfig config = heading_known(data);
   config.anchor = data.origin;
   Estimator ordered(config);
@@ -223,7 +223,7 @@ TEST(Estimator, FixesAheadOfTheImuGiveTheEstimateOfAStampOrderedFeed) {
 }
 
 TEST(Estimator, EstimatesStaticBiases) {
-  SimulatorConfig sc;
+  sim::SimulatorConfig sc;
   sc.duration_s = 120.0;
   sc.speed_m_s = 0.0;
   sc.static_s = 1000.0;
@@ -231,7 +231,7 @@ TEST(Estimator, EstimatesStaticBiases) {
   sc.initial_accel_bias_sigma = 0.1;
   sc.gnss_velocity = true;
   sc.seed = 5;
-  const DriveData data = simulate(sc);
+  const DriveData data = sim::simulate(sc);
   EstimatorConfig config = heading_known(data);
   config.use_gnss_velocity = true;  // at rest, position-only GNSS lets tilt and yaw wander
   config.anchor = data.origin;
@@ -262,7 +262,7 @@ TEST(Estimator, EstimatesStaticBiases) {
 }
 
 TEST(Estimator, InterpolatesPoseFromHistory) {
-  const DriveData data = simulate(drive(20.0));
+  const DriveData data = sim::simulate(drive(20.0));
   EstimatorConfig config = heading_known(data);
   config.anchor = data.origin;
   Estimator e(config);

@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "semap/estimation/oxts_reader.hpp"
-#include "semap/sim/drive_simulator.hpp"
 #include "semap/estimation/so3.hpp"
+#include "semap/sim/drive_simulator.hpp"
 
 namespace semap::estimation {
 namespace {
@@ -22,9 +22,9 @@ TEST(OxtsWriter, TimestampRoundTrips) {
 }
 
 DriveData simulated_car(double seconds) {
-  SimulatorConfig sc;
+  sim::SimulatorConfig sc;
   sc.duration_s = seconds;
-  return simulate(sc);
+  return sim::simulate(sc);
 }
 
 // The simulator's car through writer, parser and conversion: every IMU sample, truth pose and

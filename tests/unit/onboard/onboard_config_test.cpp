@@ -7,9 +7,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "semap/common/config.hpp"
 #include "semap/onboard/dds_outputs.hpp"
 #include "semap/onboard/segmenter_factory.hpp"
-#include "semap/common/config.hpp"
+#include "semap/sim/rig_config.hpp"
 
 namespace semap::onboard {
 namespace {
@@ -17,6 +18,12 @@ namespace {
 const std::filesystem::path kConfigDir = std::filesystem::path(SEMAP_SOURCE_DIR) / "config";
 
 // sim.yaml with `replace` swapped for `with`, written to a temporary file.
+// As semap-onboard reads a configuration: the simulated rig's own keys through sim_rig_keys.
+OnboardConfig load(const std::filesystem::path& path, sim::SimRigConfig* sim_rig = nullptr) {
+  sim::SimRigConfig unused;
+  return load_onboard_config(path, sim::sim_rig_keys(sim_rig ? *sim_rig : unused));
+}
+
 std::filesystem::path edited_sim(const std::string& replace, const std::string& with) {
   std::ifstream in(kConfigDir / "sim.yaml");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -32,7 +39,7 @@ std::filesystem::path edited_sim(const std::string& replace, const std::string& 
 std::string error_of(const std::filesystem::path& path) {
   std::string error = "no error";
   try {
-    load_onboard_config(path);
+    load(path);
   } catch (const common::ConfigError& e) {
     error = e.what();
   }
@@ -41,7 +48,8 @@ std::string error_of(const std::filesystem::path& path) {
 }
 
 TEST(OnboardConfig, SimulatedRigExample) {
-  const auto c = load_onboard_config(kConfigDir / "sim.yaml");
+  sim::SimRigConfig sim_rig;
+  const auto c = load(kConfigDir / "sim.yaml", &sim_rig);
   EXPECT_EQ(c.rig.kind, RigKind::kSim);
   EXPECT_EQ(c.camera.intrinsics.width, 640);
   EXPECT_EQ(c.camera.intrinsics.height, 480);
@@ -52,14 +60,29 @@ TEST(OnboardConfig, SimulatedRigExample) {
   EXPECT_EQ(c.depth.driver.format, common::PixelFormat::kZ16);
   EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
   EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
-  EXPECT_EQ(c.rig.camera_image, SimCameraImage::kRgb);
+  EXPECT_EQ(sim_rig.camera_image, sim::SimCameraImage::kRgb);
+  EXPECT_EQ(sim_rig.trajectory.scenario, sim::Scenario::kFigureEight);
+  EXPECT_EQ(sim_rig.scene_seed, 7u);
   EXPECT_DOUBLE_EQ(c.map.start_heading_sigma_deg, 3.0);
   const auto segmenter = make_segmenter(c.segmenter, c.map.params.num_classes);
   EXPECT_EQ(segmenter->num_classes(), c.map.params.num_classes);
 }
 
+// The robot's library knows no simulator: without the simulated rig's reader its keys are
+// unknown, named by file and line like any typo.
+TEST(OnboardConfig, TheSimulatedRigsKeysBelongToItsLibrary) {
+  std::string error = "no error";
+  try {
+    load_onboard_config(kConfigDir / "sim.yaml");
+  } catch (const common::ConfigError& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("sim.yaml:"), std::string::npos) << error;
+  EXPECT_NE(error.find("rig."), std::string::npos) << error;
+}
+
 TEST(OnboardConfig, RgbdRobotExample) {
-  const auto c = load_onboard_config(kConfigDir / "robot-rgbd.yaml");
+  const auto c = load(kConfigDir / "robot-rgbd.yaml");
   EXPECT_EQ(c.rig.kind, RigKind::kHardware);
   EXPECT_EQ(c.camera.driver.device, "/dev/video0");
   EXPECT_EQ(c.camera.driver.format, common::PixelFormat::kYuyv);
@@ -84,7 +107,7 @@ TEST(OnboardConfig, RgbdRobotExample) {
 }
 
 TEST(OnboardConfig, StereoRobotExample) {
-  const auto c = load_onboard_config(kConfigDir / "robot-stereo.yaml");
+  const auto c = load(kConfigDir / "robot-stereo.yaml");
   EXPECT_EQ(c.depth.source, DepthSource::kStereo);
   EXPECT_TRUE(std::filesystem::exists(c.depth.stereo_calibration));
   EXPECT_EQ(c.depth.stereo.num_disparities, 64);
@@ -93,7 +116,7 @@ TEST(OnboardConfig, StereoRobotExample) {
 }
 
 TEST(OnboardConfig, MapPaletteNamesTheClassesInMapInfo) {
-  const auto c = load_onboard_config(kConfigDir / "sim.yaml");
+  const auto c = load(kConfigDir / "sim.yaml");
   ASSERT_EQ(c.map.palette.names.size(), 8u);
   EXPECT_EQ(c.map.palette.names[3], "building");
   EXPECT_EQ(c.map.palette.colors[1], (mapping::Rgb{128, 64, 128}));
@@ -104,13 +127,13 @@ TEST(OnboardConfig, MapPaletteNamesTheClassesInMapInfo) {
 }
 
 TEST(OnboardConfig, ImuTakesEveryDriverKey) {
-  const auto defaults = load_onboard_config(kConfigDir / "sim.yaml");
+  const auto defaults = load(kConfigDir / "sim.yaml");
   EXPECT_EQ(defaults.imu.driver.decoder.j1939_source, SEMAP_J1939_ADDRESS_ANY);
   EXPECT_TRUE(defaults.imu.driver.restart_bus_off);
   const auto path = edited_sim(
       "  profile: semap",
       "  profile: j1939\n  j1939_source: 42\n  restart_bus_off: false\n  reconnect_min_ms: 20");
-  const auto c = load_onboard_config(path);
+  const auto c = load(path);
   std::filesystem::remove(path);
   EXPECT_EQ(c.imu.driver.decoder.profile, firmware_bridge::ImuProfile::kJ1939);
   EXPECT_EQ(c.imu.driver.decoder.j1939_source, 42);
@@ -122,7 +145,7 @@ TEST(OnboardConfig, ImuTakesEveryDriverKey) {
 }
 
 TEST(OnboardConfig, MapCheckpointAndMemoryRadius) {
-  const auto c = load_onboard_config(kConfigDir / "sim.yaml");
+  const auto c = load(kConfigDir / "sim.yaml");
   EXPECT_DOUBLE_EQ(c.map.checkpoint_s, 10.0);
   EXPECT_FALSE(c.map.resume);
   EXPECT_DOUBLE_EQ(c.map.memory_radius_m, 0.0);

@@ -7,8 +7,8 @@
 #include <opencv2/core.hpp>
 
 #include "semap/perception/depth_cloud.hpp"
-#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
+#include "semap/sim/camera.hpp"
 #include "semap/sim/world.hpp"
 
 namespace semap::perception {
@@ -30,7 +30,7 @@ TEST(OpticalToFlu, MapsAxes) {
 }
 
 // The simulated camera's true classes as a segmenter's hard labels (a perfect segmenter).
-Segmentation perfect_segmentation(const SimFrame& frame) {
+Segmentation perfect_segmentation(const sim::SimFrame& frame) {
   Segmentation seg;
   seg.num_classes = kSimMapClasses;
   seg.labels.create(frame.labels.size(), CV_16UC1);
@@ -48,13 +48,13 @@ Segmentation perfect_segmentation(const SimFrame& frame) {
 TEST(BackProjection, LandsOnTheRenderedWorld) {
   std::vector<Eigen::Vector3d> path;
   for (int i = 0; i <= 40; ++i) path.emplace_back(i, 0.0, 0.0);
-  const SimWorld world(path);
-  SimCameraOptions options;
+  const sim::SimWorld world(path);
+  sim::SimCameraOptions options;
   options.intrinsics = PinholeIntrinsics::from_fov(160, 120, std::numbers::pi_v<float> / 2);
   Eigen::Isometry3f world_from_optical = Eigen::Isometry3f::Identity();
   world_from_optical.linear() = optical_to_flu();
   world_from_optical.translation() = Eigen::Vector3f(2, 0, 1.5f);
-  const SimFrame frame = SimCamera(options).render(world, world_from_optical, 0);
+  const sim::SimFrame frame = sim::SimCamera(options).render(world, world_from_optical, 0);
   PointOptions points;
   points.max_range = 15.0f;
   DropCounts drops;

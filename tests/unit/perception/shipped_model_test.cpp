@@ -9,8 +9,8 @@
 
 #include "semap/perception/model_card.hpp"
 #include "semap/perception/onnx_segmenter.hpp"
-#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
+#include "semap/sim/camera.hpp"
 #include "semap/sim/world.hpp"
 
 namespace semap::perception {
@@ -34,12 +34,12 @@ TEST(ShippedModel, LoadsAndLabelsTheDemoWorld) {
   EXPECT_EQ(card.num_map_classes, kSimMapClasses);
   OnnxSegmenter segmenter(card);
   const auto path = loop_path();
-  SimWorldOptions options;
+  sim::SimWorldOptions options;
   options.seed = 7;
-  const SimWorld world(path, options);
-  SimCameraOptions camera_options;
+  const sim::SimWorld world(path, options);
+  sim::SimCameraOptions camera_options;
   camera_options.seed = 7;
-  const SimCamera camera(camera_options);
+  const sim::SimCamera camera(camera_options);
 
   // Confusion over the map classes 1..7, true class (rows) against the model's (columns).
   std::array<std::array<std::uint64_t, kSimMapClasses>, kSimMapClasses> confusion{};
@@ -55,7 +55,7 @@ TEST(ShippedModel, LoadsAndLabelsTheDemoWorld) {
             .toRotationMatrix() *
         optical_to_flu();
     world_from_optical.translation() = path[i].cast<float>() + Eigen::Vector3f(0, 0, 1.5f);
-    const SimFrame frame = camera.render(world, world_from_optical, static_cast<std::uint64_t>(f));
+    const sim::SimFrame frame = camera.render(world, world_from_optical, static_cast<std::uint64_t>(f));
     const Segmentation seg = segmenter.segment(frame.bgr);
     ASSERT_EQ(seg.labels.size(), frame.labels.size());
     for (int v = 0; v < frame.labels.rows; ++v) {

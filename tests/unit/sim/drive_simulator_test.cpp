@@ -5,13 +5,16 @@
 #include "semap/estimation/left_inekf.hpp"
 #include "semap/estimation/so3.hpp"
 
-namespace semap::estimation {
+namespace semap::sim {
 namespace {
+
+// The simulated drive is scored with the filter's own types.
+using namespace semap::estimation;
 
 using Eigen::Vector3d;
 
 SimulatorConfig noiseless(Scenario scenario) {
-  SimulatorConfig c;
+  sim::SimulatorConfig c;
   c.scenario = scenario;
   c.duration_s = 60.0;
   c.imu_noise.gyro_noise.setZero();
@@ -27,8 +30,8 @@ SimulatorConfig noiseless(Scenario scenario) {
 // Dead reckoning on noise-free IMU samples must reproduce the truth: the samples and the
 // ground truth come from the same motion.
 TEST(Simulator, ImuIntegratesToTruth) {
-  for (Scenario s : {Scenario::kCar, Scenario::kFigureEight}) {
-    const DriveData d = simulate(noiseless(s));
+  for (Scenario s : {sim::Scenario::kCar, sim::Scenario::kFigureEight}) {
+    const DriveData d = sim::simulate(noiseless(s));
     LeftInekf f(FilterParams{});
     f.reset(d.truth.front().state, Matrix15::Identity());
     for (std::size_t i = 1; i < d.imu.size(); ++i) {
@@ -49,11 +52,11 @@ TEST(Simulator, ImuIntegratesToTruth) {
 }
 
 TEST(Simulator, GnssRateDropoutsJumpsAndOrdering) {
-  SimulatorConfig c = noiseless(Scenario::kCar);
+  sim::SimulatorConfig c = noiseless(sim::Scenario::kCar);
   c.gnss_sigma_m = 0.0;
   c.lever_arm = Vector3d(0.0, 0.0, 1.5);
   c.jumps.push_back({30.0, 2.0, Vector3d(0.0, 50.0, 0.0)});
-  const DriveData d = simulate(c);
+  const DriveData d = sim::simulate(c);
   EXPECT_NEAR(static_cast<double>(d.gnss.size()), 600.0, 1.0);
   EXPECT_EQ(d.truth.size(), d.imu.size());
   for (std::size_t i = 1; i < d.gnss.size(); ++i) EXPECT_LT(d.gnss[i - 1].stamp, d.gnss[i].stamp);
@@ -76,9 +79,9 @@ TEST(Simulator, GnssRateDropoutsJumpsAndOrdering) {
 
   c.dropouts_per_minute = 6.0;
   c.dropout_duration_s = 3.0;
-  const DriveData gaps = simulate(c);
+  const DriveData gaps = sim::simulate(c);
   EXPECT_LT(gaps.gnss.size(), d.gnss.size() - 60);
 }
 
 }  // namespace
-}  // namespace semap::estimation
+}  // namespace semap::sim

@@ -14,12 +14,15 @@
 #include <thread>
 #include <vector>
 
-#include "semap/sim/constant_turn_source.hpp"
 #include "semap/firmware_bridge/gnss_stream_decoder.hpp"
 #include "semap/firmware_bridge/linux_can.hpp"
+#include "semap/sim/constant_turn_source.hpp"
 
-namespace semap::firmware_bridge {
+namespace semap::sim {
 namespace {
+
+// The emulator speaks the firmware's codecs; the tests decode with them.
+using namespace semap::firmware_bridge;
 
 // A pty pair in raw mode, as a GNSS driver would configure its end.
 struct Pty {
@@ -317,4 +320,4 @@ TEST(Emulator, PacesInScaledRealTime) {
 INSTANTIATE_TEST_SUITE_P(Seeds, EmulatorSeed, ::testing::Values(1u, 2u, 3u));
 
 }  // namespace
-}  // namespace semap::firmware_bridge
+}  // namespace semap::sim

@@ -13,13 +13,15 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "semap/sim/camera.hpp"
 #include "semap/perception/sim_classes.hpp"
+#include "semap/sim/camera.hpp"
 
-namespace semap::perception {
+namespace semap::sim {
 namespace {
 
-namespace id = sim_train_id;
+// The world is labelled in the perception library's classes.
+using namespace semap::perception;
+namespace id = perception::sim_train_id;
 constexpr std::array<std::uint8_t, 8> kWorldClasses = {id::kRoad, id::kSidewalk,   id::kBuilding,
                                                        id::kPole, id::kVegetation, id::kTerrain,
                                                        id::kSky,  id::kCar};
@@ -399,4 +401,4 @@ TEST_F(SimWorldTest, RenderTime) {
 }
 
 }  // namespace
-}  // namespace semap::perception
+}  // namespace semap::sim

@@ -102,6 +102,8 @@ class Estimator {
   int consecutive_rejections_ = 0;
 };
 
-std::unique_ptr<NavFilter> make_filter(FilterKind kind, const FilterParams& params);
+// covariance_window: the Left-InEKF's (EstimatorConfig::covariance_window).
+std::unique_ptr<NavFilter> make_filter(FilterKind kind, const FilterParams& params,
+                                       int covariance_window = LeftInekf::kDefaultWindowSteps);
 
 }  // namespace semap::estimation

@@ -8,6 +8,7 @@
 #include "semap/estimation/filter_params.hpp"
 #include "semap/estimation/geodesy.hpp"
 #include "semap/estimation/imu_validator.hpp"
+#include "semap/estimation/left_inekf.hpp"
 
 namespace semap::estimation {
 
@@ -46,6 +47,10 @@ struct ReanchorConfig {
 struct EstimatorConfig {
   FilterKind filter = FilterKind::kLeftInekf;
   FilterParams params;
+  // Left-InEKF: IMU steps whose covariance propagation is gathered into one product before it
+  // is applied (at most 0.32 s). 1 is the textbook per-step propagation, the definition the
+  // window is tested against.
+  int covariance_window = LeftInekf::kDefaultWindowSteps;
   ImuLimits imu_limits;
   InitConfig init;
   ReanchorConfig reanchor;

@@ -4,9 +4,9 @@
 #include <string_view>
 #include <vector>
 
+#include "semap/estimation/drive_data.hpp"
 #include "semap/estimation/estimator.hpp"
 #include "semap/estimation/metrics.hpp"
-#include "semap/estimation/drive_data.hpp"
 
 namespace semap::estimation {
 

@@ -64,6 +64,6 @@ inline constexpr double kMinPacketSigmaM = 0.01;
 // pos_accuracy with kPacketAccuracy) and that sigma as covariance, and the OXTS solution as
 // truth (biases unknown, left zero), anchored at the first record.
 DriveData oxts_to_inputs(const OxtsData& data, double gnss_sigma_m, std::uint64_t seed,
-                              OxtsGnssNoise noise = OxtsGnssNoise::kFixedSigma);
+                         OxtsGnssNoise noise = OxtsGnssNoise::kFixedSigma);
 
 }  // namespace semap::estimation

@@ -15,6 +15,14 @@ struct StampedPose {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // body to world
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+
+  // World from body, for transforming what the robot sensed at this pose.
+  Eigen::Isometry3f world_from_body() const {
+    Eigen::Isometry3f t = Eigen::Isometry3f::Identity();
+    t.linear() = orientation.toRotationMatrix().cast<float>();
+    t.translation() = position.cast<float>();
+    return t;
+  }
 };
 
 // The last `capacity` filter poses in a ring, for interpolating the pose at a sensor stamp

@@ -6,13 +6,13 @@
 
 namespace semap::mapping {
 
-// The cloud with its points and sensor origin expressed in another frame: p' = T p.
-inline common::LabeledCloud transform_cloud(const common::LabeledCloud& cloud,
+// The cloud with its points and sensor origin expressed in another frame: p' = T p. Taken by
+// value, so a cloud handed over with std::move is transformed in place.
+inline common::LabeledCloud transform_cloud(common::LabeledCloud cloud,
                                             const Eigen::Isometry3f& T) {
-  common::LabeledCloud out = cloud;
-  out.origin = T * cloud.origin;
-  for (auto& p : out.points) p = T * p;
-  return out;
+  cloud.origin = T * cloud.origin;
+  for (auto& p : cloud.points) p = T * p;
+  return cloud;
 }
 
 }  // namespace semap::mapping

@@ -6,15 +6,15 @@
 #include <unordered_set>
 #include <vector>
 
-#include "semap/onboard/estimation_stage.hpp"
-#include "semap/onboard/mapping_stage.hpp"
-#include "semap/onboard/onboard_config.hpp"
 #include "semap/dds_idl/health.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/dds_idl/participant.hpp"
 #include "semap/dds_idl/topic.hpp"
 #include "semap/dds_idl/types.hpp"
 #include "semap/dds_idl/writer.hpp"
+#include "semap/onboard/estimation_stage.hpp"
+#include "semap/onboard/mapping_stage.hpp"
+#include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/stage_thread.hpp"
 
 namespace semap::onboard {

@@ -8,11 +8,11 @@
 #include <thread>
 #include <vector>
 
-#include "semap/onboard/latency_window.hpp"
-#include "semap/onboard/onboard_config.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/estimation/estimator.hpp"
+#include "semap/onboard/latency_window.hpp"
+#include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
 #include "semap/onboard/stage_thread.hpp"
 #include "semap/onboard/trajectory_log.hpp"

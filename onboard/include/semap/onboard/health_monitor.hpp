@@ -5,10 +5,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "semap/onboard/latency_window.hpp"
 #include "semap/common/stamp.hpp"
 #include "semap/dds_idl/health.hpp"
 #include "semap/drivers/driver_counters.hpp"
+#include "semap/onboard/latency_window.hpp"
 
 namespace semap::onboard {
 

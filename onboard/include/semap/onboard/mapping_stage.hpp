@@ -9,9 +9,6 @@
 #include <unordered_map>
 #include <vector>
 
-#include "semap/onboard/costmap_output.hpp"
-#include "semap/onboard/latency_window.hpp"
-#include "semap/onboard/onboard_config.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/dds_idl/block_snapshot.hpp"
@@ -19,6 +16,9 @@
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/mapping/map_checkpoint.hpp"
 #include "semap/mapping/semantic_map.hpp"
+#include "semap/onboard/costmap_output.hpp"
+#include "semap/onboard/latency_window.hpp"
+#include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/stage_thread.hpp"
 
 namespace semap::onboard {

@@ -7,8 +7,6 @@
 #include <optional>
 #include <string>
 
-#include "semap/onboard/costmap_output.hpp"
-#include "semap/onboard/perception_config.hpp"
 #include "semap/common/config.hpp"
 #include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/topic_names.hpp"
@@ -19,6 +17,8 @@
 #include "semap/mapping/class_palette.hpp"
 #include "semap/mapping/layered_map.hpp"
 #include "semap/mapping/map_params.hpp"
+#include "semap/onboard/costmap_output.hpp"
+#include "semap/onboard/perception_config.hpp"
 
 namespace semap::onboard {
 

@@ -6,15 +6,15 @@
 #include <mutex>
 #include <thread>
 
-#include "semap/onboard/latency_window.hpp"
-#include "semap/onboard/perception_config.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/drivers/jpeg_decoder.hpp"
-#include "semap/perception/labelled_points.hpp"
-#include "semap/perception/segmentation.hpp"
+#include "semap/onboard/latency_window.hpp"
+#include "semap/onboard/perception_config.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
 #include "semap/onboard/stage_thread.hpp"
+#include "semap/perception/labelled_points.hpp"
+#include "semap/perception/segmentation.hpp"
 
 namespace semap::perception {
 class StereoDepth;
@@ -111,8 +111,5 @@ class PerceptionStage {
   LatencyWindow latency_;
   StageThread<PerceptionStageStats> stage_;  // last: joined before the members it uses
 };
-
-// A body-frame cloud in the world frame, with the robot at `pose`.
-common::LabeledCloud to_world(common::LabeledCloud cloud, const estimation::StampedPose& pose);
 
 }  // namespace semap::onboard

@@ -88,8 +88,10 @@ class Pipeline {
   const std::filesystem::path& checkpoint_path() const { return checkpoint_path_; }
   // Every ring's drops, by name.
   std::vector<std::pair<std::string, std::uint64_t>> ring_drops() const;
-  // After stop(): the whole map (read back from the checkpoint when it was paged).
+  // After stop(): the whole map (read back from the checkpoint when it was paged), and that map
+  // written as a .smap file.
   const mapping::SemanticMap& map() { return mapping_->map(); }
+  void save_map(const std::filesystem::path& path);
   // After stop(): the exit summary, one line per part (tests read them).
   std::vector<std::string> summary() const;
 

@@ -10,15 +10,15 @@
 #include <string>
 #include <thread>
 
-#include "semap/onboard/onboard_config.hpp"
-#include "semap/onboard/sensor_rig.hpp"
-#include "semap/onboard/pseudo_terminal.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/drivers/stream_log.hpp"
 #include "semap/firmware_bridge/can_imu_decoder.hpp"
 #include "semap/firmware_bridge/candump_reader.hpp"
 #include "semap/firmware_bridge/gnss_stream_decoder.hpp"
+#include "semap/onboard/onboard_config.hpp"
+#include "semap/onboard/pseudo_terminal.hpp"
+#include "semap/onboard/sensor_rig.hpp"
 
 namespace semap::onboard {
 

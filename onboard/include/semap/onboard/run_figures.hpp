@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
 #include "semap/onboard/estimation_stage.hpp"
 #include "semap/onboard/health_monitor.hpp"
 #include "semap/onboard/mapping_stage.hpp"
 #include "semap/onboard/perception_stage.hpp"
-#include "semap/common/messages.hpp"
-#include "semap/common/spsc_ring.hpp"
 
 namespace semap::onboard {
 

@@ -30,7 +30,8 @@ struct SimCameraOptions {
 struct SimFrame {
   cv::Mat bgr;      // CV_8UC3
   cv::Mat depth_m;  // CV_32FC1, z-depth in metres, 0 = no return
-  cv::Mat labels;   // CV_8UC1, Cityscapes train id (perception::sim_train_id), sky where nothing is hit
+  cv::Mat
+      labels;  // CV_8UC1, Cityscapes train id (perception::sim_train_id), sky where nothing is hit
 };
 
 // A colour + depth camera with perfect labels in a SimWorld. Colour: textured albedo,

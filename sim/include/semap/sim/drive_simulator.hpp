@@ -4,9 +4,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "semap/estimation/drive_data.hpp"
 #include "semap/estimation/filter_params.hpp"
 #include "semap/estimation/geodesy.hpp"
-#include "semap/estimation/drive_data.hpp"
 #include "semap/estimation/nav_state.hpp"
 
 namespace semap::sim {
@@ -28,7 +28,7 @@ struct SimulatorConfig {
   double imu_rate_hz = 100.0;
   double gnss_rate_hz = 10.0;
   double gnss_phase_s = 0.003;             // fixes fall between IMU samples, as on real hardware
-  estimation::ImuNoise imu_noise;                      // also drives the bias random walk
+  estimation::ImuNoise imu_noise;          // also drives the bias random walk
   double initial_gyro_bias_sigma = 0.005;  // rad/s
   double initial_accel_bias_sigma = 0.05;  // m/s^2
   double gnss_sigma_m = 1.0;               // per axis

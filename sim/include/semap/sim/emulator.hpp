@@ -12,7 +12,6 @@
 
 namespace semap::sim {
 
-
 // Fault probabilities are per IMU sample (CAN faults) or per GNSS epoch (serial faults). At most
 // one CAN fault hits a sample, so a receiver's counters can be compared exactly.
 struct FaultConfig {

@@ -11,9 +11,10 @@
 #include <utility>
 #include <vector>
 
+#include "semap/mapping/confusion_matrix.hpp"
 #include "semap/onboard/estimation_stage.hpp"
-#include "semap/onboard/pipeline.hpp"
 #include "semap/onboard/latency_window.hpp"
+#include "semap/onboard/pipeline.hpp"
 #include "semap/perception/segmentation.hpp"
 #include "semap/perception/sim_classes.hpp"
 #include "semap/sim/rig.hpp"
@@ -31,8 +32,7 @@ struct PoseVsTruth {
   Eigen::Vector3d truth;
   common::Stamp stamp;
 };
-std::optional<PoseVsTruth> pose_vs_truth(const SimRig& rig,
-                                         const onboard::EstimationStageStats& s);
+std::optional<PoseVsTruth> pose_vs_truth(const SimRig& rig, const onboard::EstimationStageStats& s);
 
 // Position error of the live estimate against the rig's truth, in the simulator's frame.
 class LiveAccuracy {
@@ -48,28 +48,6 @@ class LiveAccuracy {
   double sum_sq_ = 0.0;
   double max_ = 0.0;
   std::size_t count_ = 0;
-};
-
-// A confusion matrix over the K = 8 map classes: rows the true class (0 = free), columns the
-// predicted class, plus a last column for "no label".
-class ClassConfusion {
- public:
-  static constexpr int K = perception::kSimMapClasses;
-  void add(std::uint16_t truth, std::uint16_t predicted, std::uint64_t count = 1);
-  // IoU of map class c (1..K-1), nullopt when the truth never has it.
-  std::optional<double> iou(int c) const;
-  // Mean IoU over the classes the truth has (NaN when it has none).
-  double mean_iou() const;
-  // Counted with true class c.
-  std::uint64_t truth_count(int c) const;
-  // Counted with true class `truth` and predicted class `predicted` (K: no label).
-  std::uint64_t count(int truth, int predicted) const { return counts_[truth][predicted]; }
-  std::uint64_t total() const;
-  // The same without the true free cells (the semantic part of a map's errors alone).
-  ClassConfusion without_free() const;
-
- private:
-  std::array<std::array<std::uint64_t, K + 1>, K> counts_{};
 };
 
 // The figures of the run the report does not measure itself.
@@ -117,8 +95,8 @@ class SimReport final : public onboard::PipelineObserver {
   void sample_pose(const onboard::EstimationStageStats& s);
   std::filesystem::path write(const RunFigures& run, const mapping::SemanticMap& map,
                               const onboard::EstimationStageStats& final) const;
-  ClassConfusion map_confusion(const mapping::SemanticMap& map,
-                               const onboard::EstimationStageStats& final) const;
+  mapping::ConfusionMatrix map_confusion(const mapping::SemanticMap& map,
+                                         const onboard::EstimationStageStats& final) const;
   void write_camera_png() const;
   void write_trajectory_png(std::optional<double> rmse) const;
   void write_truth_csv(const onboard::EstimationStageStats& final) const;
@@ -126,7 +104,7 @@ class SimReport final : public onboard::PipelineObserver {
   const SimRig& rig_;
   std::filesystem::path dir_;
   mutable std::mutex mutex_;  // the segmentation figures, written on the perception thread
-  ClassConfusion pixels_;
+  mapping::ConfusionMatrix pixels_{perception::kSimMapClasses};
   std::uint64_t frames_observed_ = 0;
   std::optional<Sample> sample_;
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> track_;  // (truth, estimate) xy

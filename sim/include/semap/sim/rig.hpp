@@ -5,17 +5,17 @@
 #include <memory>
 #include <thread>
 
+#include "semap/common/messages.hpp"
+#include "semap/common/spsc_ring.hpp"
+#include "semap/drivers/can_socket.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/pseudo_terminal.hpp"
 #include "semap/onboard/sensor_rig.hpp"
-#include "semap/common/messages.hpp"
-#include "semap/common/spsc_ring.hpp"
+#include "semap/sim/camera_feed.hpp"
 #include "semap/sim/drive_simulator.hpp"
 #include "semap/sim/emulator.hpp"
-#include "semap/drivers/can_socket.hpp"
-#include "semap/sim/world.hpp"
-#include "semap/sim/camera_feed.hpp"
 #include "semap/sim/rig_config.hpp"
+#include "semap/sim/world.hpp"
 
 namespace semap::sim {
 
