@@ -55,7 +55,8 @@ TEST(ShippedModel, LoadsAndLabelsTheDemoWorld) {
             .toRotationMatrix() *
         optical_to_flu();
     world_from_optical.translation() = path[i].cast<float>() + Eigen::Vector3f(0, 0, 1.5f);
-    const sim::SimFrame frame = camera.render(world, world_from_optical, static_cast<std::uint64_t>(f));
+    const sim::SimFrame frame =
+        camera.render(world, world_from_optical, static_cast<std::uint64_t>(f));
     const Segmentation seg = segmenter.segment(frame.bgr);
     ASSERT_EQ(seg.labels.size(), frame.labels.size());
     for (int v = 0; v < frame.labels.rows; ++v) {
