@@ -53,6 +53,12 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
       poses_(config.estimator.history),
       rig_(make_rig(SensorRings{imu_ring_, gnss_ring_, colour_ring_, depth_ring_})) {
   auto log = common::logger("onboard");
+  const bool inekf = config_.estimator.filter == estimation::FilterKind::kLeftInekf;
+  log->info(
+      "estimator: {}{}; map: {} with the {} engine", inekf ? "left-inekf" : "eskf",
+      inekf ? " (covariance window " + std::to_string(config_.estimator.covariance_window) + ")"
+            : "",
+      mapping::to_string(config_.map.params.method), mapping::to_string(config_.map.params.engine));
   if (config_.dds.enabled && !config_.dds.cyclone_config.empty() &&
       !std::getenv("CYCLONEDDS_URI")) {
     setenv("CYCLONEDDS_URI", ("file://" + config_.dds.cyclone_config.string()).c_str(), 1);

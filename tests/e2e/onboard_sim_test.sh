@@ -128,10 +128,16 @@ esac
 rmse=$(json pose_rmse_m)
 at_most "$rmse" 0.5 || fail "pose RMSE $rmse m > 0.5 m"
 mapped=$(json frames_mapped) captured=$(json frames_captured)
-# The camera runs at 15 Hz; frames before the filter's heading settles get no pose. Every
-# frame after that must reach the map (a few may be passed over).
+# The camera runs at 15 Hz (the rig renders 13 to 15 frames a second on the 2-core test
+# machine; fewer than 10 means it is starved); frames before the filter's heading settles get no
+# pose. Every frame rendered reaches perception, and every frame after that must reach the map
+# (a few may be passed over).
 unposed=$(sed -n 's/^perception *: .* \([0-9]*\) without a pose.*/\1/p' "$work/onboard.log")
-at_least "$captured" $((14 * duration)) || fail "$captured frames captured in $duration s"
+taken=$(sed -n 's/^perception *: \([0-9]*\) frames,.*/\1/p' "$work/onboard.log")
+at_least "$captured" $((10 * duration)) || fail "$captured frames captured in $duration s"
+colour_drops=$(sed -n 's/^ring drops *: .*, colour \([0-9]*\),.*/\1/p' "$work/onboard.log")
+[[ $((taken + colour_drops)) -eq "$captured" ]] ||
+  fail "$captured frames rendered; perception took $taken, the colour ring dropped $colour_drops"
 at_least "$((mapped * 100))" $(((captured - unposed) * 95)) ||
   fail "$mapped frames mapped of $((captured - unposed)) with a pose"
 at_least "$mapped" $((4 * duration)) || fail "only $mapped frames mapped"
