@@ -1,6 +1,5 @@
 #include "semap/mapping/semantic_map.hpp"
 
-#include <tbb/concurrent_queue.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -9,6 +8,7 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -71,8 +71,12 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
     detail::TilePlan plan;
     std::exception_ptr error;
   };
-  // Fused scans' Prepared objects, reused so that their plans' buffers are not reallocated.
-  tbb::concurrent_queue<std::shared_ptr<Prepared>> spare;
+  // Every Prepared object, owned here; the pipeline passes plain pointers between its stages
+  // (TBB's own copies of a non-trivial item would outlive the pipeline). A fused scan's object
+  // goes back to `spare` for reuse, so its plan's buffers are not reallocated.
+  std::mutex pool_mutex;
+  std::vector<std::unique_ptr<Prepared>> pool;
+  std::vector<Prepared*> spare;
   std::vector<InsertResult> results;
   results.reserve(clouds.size());
   std::size_t next = 0;
@@ -90,11 +94,20 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
                                             }
                                             return next++;
                                           }) &
-          tbb::make_filter<std::size_t, std::shared_ptr<Prepared>>(
+          tbb::make_filter<std::size_t, Prepared*>(
               tbb::filter_mode::parallel,
               [&](std::size_t scan) {
-                std::shared_ptr<Prepared> prepared;
-                if (!spare.try_pop(prepared)) prepared = std::make_shared<Prepared>();
+                Prepared* prepared = nullptr;
+                {
+                  std::lock_guard lock(pool_mutex);
+                  if (spare.empty()) {
+                    pool.push_back(std::make_unique<Prepared>());
+                    prepared = pool.back().get();
+                  } else {
+                    prepared = spare.back();
+                    spare.pop_back();
+                  }
+                }
                 try {
                   prepared->timed = build_timed(clouds[scan], origins[scan], params_);
                   if (params_.engine == Engine::kTiled) {
@@ -105,14 +118,15 @@ std::vector<InsertResult> SemanticMap::insert(std::span<const common::LabeledClo
                 }
                 return prepared;
               }) &
-          tbb::make_filter<std::shared_ptr<Prepared>, void>(
-              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Prepared>& prepared) {
+          tbb::make_filter<Prepared*, void>(
+              tbb::filter_mode::serial_in_order, [&](Prepared* prepared) {
                 if (prepared->error) std::rethrow_exception(prepared->error);
                 results.push_back(
                     fuse_scan(prepared->timed.training,
                               params_.engine == Engine::kTiled ? &prepared->plan : nullptr));
                 results.back().phases.training = prepared->timed.seconds;
-                spare.push(prepared);
+                std::lock_guard lock(pool_mutex);
+                spare.push_back(prepared);
               }));
   return results;
 }
