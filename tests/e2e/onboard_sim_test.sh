@@ -18,6 +18,7 @@
 #   into posed clouds and the map took (nearly) every one, the listener saw no rejected
 #   blocks and plausible rt/semap/health reports.
 set -euo pipefail
+. "$(dirname "${BASH_SOURCE[0]}")/stage_counts.sh"
 onboard="$1" listener="$2" config="$3" xml="$4" exporter="$5"
 export CYCLONEDDS_URI="file://$xml"
 domain=$(((RANDOM % 200) + 20))
@@ -180,20 +181,8 @@ costmap=$(grep '^costmap ' "$work/onboard.log" || true)
 grids=$(awk '{print $3}' <<<"$costmap")
 num "costmap grids" "$grids"
 [[ "$grids" -ge 5 ]] || fail "costmap: '$costmap'"
-# Stopping drains every ring through its stage: each colour frame taken became a cloud or is
-# counted with its reason, and each cloud is in the map or counted as dropped by the cloud ring
-# (which drops the oldest rather than stall perception).
-perception=$(grep '^perception *: ' "$work/onboard.log" || true)
-read -r frames posed skipped unpaired bad unposed < <(sed -n 's/^perception *: \([0-9]*\) frames, \([0-9]*\) clouds mapped ([0-9]* points), \([0-9]*\) passed over, \([0-9]*\) unpaired, \([0-9]*\) bad, \([0-9]*\) without a pose.*/\1 \2 \3 \4 \5 \6/p' <<<"$perception")
-scans=$(sed -n 's/^mapping *: \([0-9]*\) scans.*/\1/p' "$work/onboard.log")
-cloud_drops=$(sed -n 's/^ring drops *: .*, clouds \([0-9]*\)$/\1/p' "$work/onboard.log")
-for figure in frames posed skipped unpaired bad unposed scans cloud_drops mapped; do
-  num "$figure" "${!figure:-}"
-done
-[[ $((posed + skipped + unpaired + bad + unposed)) -eq "$frames" ]] ||
-  fail "perception: $frames frames but $posed clouds + $skipped + $unpaired + $bad + $unposed lost"
-[[ $((scans + cloud_drops)) -eq "$posed" ]] ||
-  fail "perception made $posed clouds; mapped $scans, the ring dropped $cloud_drops"
+check_stage_counts "$work/onboard.log"
+num "frames mapped" "$mapped"
 [[ "$mapped" -eq "$scans" ]] || fail "report: $mapped frames mapped, summary: $scans scans"
 field() { # field LINE KIND NAME KEY: the value after "KIND NAME ... KEY" within that entry
   awk -v kind="$2" -v name="$3" -v key="$4" '{
@@ -222,9 +211,7 @@ num "gnss bad" "$gnss_bad"
 awk -v r="$perc_rate" -v b="$perc_p99" 'BEGIN { exit !(r > 2 && b > 0 && b < 1000) }' ||
   fail "perception health implausible: $health"
 # Ring drops in the health report are the rings' own counters: never more than at exit.
-cloud_drops=$(sed -n 's/^ring drops .* clouds \([0-9]*\)$/\1/p' "$work/onboard.log")
 num "mapping drops" "$map_drops"
-num "cloud ring drops" "$cloud_drops"
 [[ "$map_drops" -le "$cloud_drops" ]] ||
   fail "mapping drops $map_drops vs cloud ring drops at exit '$cloud_drops'"
 echo "e2e: last $health"

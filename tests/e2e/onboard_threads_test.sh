@@ -13,6 +13,7 @@
 # - the summary's counts agree stage to stage: every colour frame taken is a cloud or counted
 #   with its reason, and every cloud is in the map or counted as dropped by the cloud ring.
 set -euo pipefail
+. "$(dirname "${BASH_SOURCE[0]}")/stage_counts.sh"
 onboard="$1" listener="$2" config="$3" xml="$4"
 export CYCLONEDDS_URI="file://$xml"
 domain=$(((RANDOM % 200) + 20))
@@ -61,16 +62,6 @@ num "listener blocks" "$blocks"
 num "listener rejected" "$rejected"
 [[ "$blocks" -gt 0 && "$rejected" -eq 0 ]] || fail "listener: $last"
 
-perception=$(grep '^perception *: ' "$work/onboard.log" || true)
-read -r frames posed skipped unpaired bad unposed < <(sed -n 's/^perception *: \([0-9]*\) frames, \([0-9]*\) clouds mapped ([0-9]* points), \([0-9]*\) passed over, \([0-9]*\) unpaired, \([0-9]*\) bad, \([0-9]*\) without a pose.*/\1 \2 \3 \4 \5 \6/p' <<<"$perception")
-scans=$(sed -n 's/^mapping *: \([0-9]*\) scans.*/\1/p' "$work/onboard.log")
-cloud_drops=$(sed -n 's/^ring drops *: .*, clouds \([0-9]*\)$/\1/p' "$work/onboard.log")
-for figure in frames posed skipped unpaired bad unposed scans cloud_drops; do
-  num "$figure" "${!figure:-}"
-done
+check_stage_counts "$work/onboard.log"
 [[ "$scans" -gt 0 ]] || fail "nothing mapped"
-[[ $((posed + skipped + unpaired + bad + unposed)) -eq "$frames" ]] ||
-  fail "perception: $frames frames but $posed clouds + $skipped + $unpaired + $bad + $unposed lost"
-[[ $((scans + cloud_drops)) -eq "$posed" ]] ||
-  fail "perception made $posed clouds; mapped $scans, the ring dropped $cloud_drops"
 echo "e2e: every thread ran: $frames frames, $posed clouds, $scans mapped, $blocks blocks received"
