@@ -10,6 +10,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -191,6 +192,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   common::setup_logging(config.log_level);
+  if (config.dds.enabled && !config.dds.cyclone_config.empty() && !std::getenv("CYCLONEDDS_URI")) {
+    setenv("CYCLONEDDS_URI", ("file://" + config.dds.cyclone_config.string()).c_str(), 1);
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {

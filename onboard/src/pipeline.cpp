@@ -1,7 +1,6 @@
 #include "semap/onboard/pipeline.hpp"
 
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -59,10 +58,6 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
       inekf ? " (covariance window " + std::to_string(config_.estimator.covariance_window) + ")"
             : "",
       mapping::to_string(config_.map.params.method), mapping::to_string(config_.map.params.engine));
-  if (config_.dds.enabled && !config_.dds.cyclone_config.empty() &&
-      !std::getenv("CYCLONEDDS_URI")) {
-    setenv("CYCLONEDDS_URI", ("file://" + config_.dds.cyclone_config.string()).c_str(), 1);
-  }
   // The configuration has read the model card, palette and calibration; a network OpenCV then
   // fails to load leaves the robot localising without a map: localisation must not depend on
   // the camera half.
