@@ -3,24 +3,23 @@
 // (onboard::Pipeline) until it is stopped or the rig has played all it had, saves the map and
 // prints the summary. --record DIR saves the raw sensor streams; --report DIR (simulated rig)
 // writes images, the map and summary.json scored against the simulated truth.
-#include <sys/resource.h>
-
 #include <CLI/CLI.hpp>
 #include <atomic>
-#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <thread>
+#include <stdexcept>
+#include <vector>
 
 #include "semap/common/logging.hpp"
 #include "semap/onboard/hardware_rig.hpp"
 #include "semap/onboard/pipeline.hpp"
 #include "semap/onboard/replay_rig.hpp"
-#include "semap/onboard/service_notifier.hpp"
+#include "semap/onboard/service.hpp"
 #include "semap/onboard/stream_recorder.hpp"
 #include "semap/sim/report.hpp"
 #include "semap/sim/rig.hpp"
@@ -40,16 +39,8 @@ struct RunOptions {
   std::string trajectory;
 };
 
-double cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
 int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_config,
         const RunOptions& options) {
-  auto log = common::logger("onboard");
   sim::SimRig* sim_rig = nullptr;
   onboard::Pipeline pipeline(
       config,
@@ -79,44 +70,20 @@ int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_confi
     report = std::make_unique<sim::SimReport>(*sim_rig, options.report_dir);
     pipeline.attach(*report);
   }
+  std::vector<std::filesystem::path> save_paths;
+  if (!config.map.save_path.empty()) save_paths.emplace_back(config.map.save_path);
+  if (!options.report_dir.empty()) save_paths.push_back(report->dir() / "map.smap");
 
-  const auto started = std::chrono::steady_clock::now();
-  pipeline.start();
-  const onboard::ServiceNotifier service;
-  service.ready();
-  if (service.watchdog_enabled()) log->info("systemd watchdog: pinging every second");
-  auto next_watchdog = started;
-  while (!g_stop.load() && !pipeline.finished()) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    pipeline.tick();
-    if (const auto now = std::chrono::steady_clock::now(); now >= next_watchdog) {
-      next_watchdog = now + std::chrono::seconds(1);
-      service.watchdog();  // the main loop is alive
-    }
-  }
-  service.stopping();
-  pipeline.stop();
+  onboard::run_service(pipeline, g_stop, save_paths);
 
-  if (!config.map.save_path.empty()) pipeline.save_map(config.map.save_path);
-  if (report && !report->dir().empty()) pipeline.save_map(report->dir() / "map.smap");
   std::printf("\n== semap-onboard summary ==\n");
   for (const auto& line : pipeline.summary()) std::printf("%s\n", line.c_str());
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  const double cores = cpu_seconds() / wall_s;
-  std::printf("cpu              : %.2f cores over %.1f s\n", cores, wall_s);
-  if (report && !report->dir().empty()) {
-    const bool onnx = config.segmenter.kind == onboard::SegmenterConfig::Kind::kOnnx;
-    const auto summary = report->write(pipeline, onnx ? "onnx" : "palette", cores);
-    std::printf("report           : %s\n", summary.c_str());
+  if (!options.report_dir.empty()) {
+    std::printf("report           : %s\n", report->write(pipeline).c_str());
   }
   // Stopped by a signal (systemctl stop, Ctrl-C), the run ended as asked: the map is saved, and
-  // a service stopped before its filter initialised or its camera mapped has not failed. A run
-  // that ended by itself fails when the filter never initialised, or when it had a camera and
-  // mapped nothing.
-  if (g_stop.load()) return 0;
-  const bool mapped = !pipeline.rig().has_camera() || pipeline.mapping().scans > 0;
-  return pipeline.estimation().initialised && mapped ? 0 : 1;
+  // a service stopped before its filter initialised or its camera mapped has not failed.
+  return g_stop.load() || pipeline.succeeded() ? 0 : 1;
 }
 
 }  // namespace
@@ -179,16 +146,14 @@ int main(int argc, char** argv) {
       config.map.checkpoint_path = options.report_dir + "/map.log";
     }
     onboard::check_paths(config, options.config_path);
+    if (!options.record_dir.empty() && config.rig.kind == onboard::RigKind::kReplay) {
+      throw std::invalid_argument("--record cannot record a replay");
+    }
+    if (!options.report_dir.empty() && config.rig.kind != onboard::RigKind::kSim) {
+      throw std::invalid_argument("--report needs the simulated rig (rig.kind: sim)");
+    }
   } catch (const std::exception& e) {
     std::cerr << "semap-onboard: " << e.what() << "\n";
-    return 2;
-  }
-  if (!options.record_dir.empty() && config.rig.kind == onboard::RigKind::kReplay) {
-    std::cerr << "semap-onboard: --record cannot record a replay\n";
-    return 2;
-  }
-  if (!options.report_dir.empty() && config.rig.kind != onboard::RigKind::kSim) {
-    std::cerr << "semap-onboard: --report needs the simulated rig (rig.kind: sim)\n";
     return 2;
   }
   common::setup_logging(config.log_level);

@@ -1,5 +1,7 @@
 #include "semap/onboard/pipeline.hpp"
 
+#include <spdlog/fmt/fmt.h>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -127,6 +129,7 @@ void Pipeline::start() {
   rig_->start();
   running_ = true;
   started_ = common::Stamp::now();
+  cpu_at_start_s_ = process_cpu_seconds();
   next_health_ = started_;
   next_progress_ = started_ + 5.0;
   common::logger("onboard")->info("running {}", rig_->describe());
@@ -166,6 +169,13 @@ void Pipeline::stop() {
   mapping_->stop();
   if (dds_) dds_->stop();  // the map's last changes go out
   for (PipelineObserver* o : observers_) o->on_stopped();
+  wall_s_ = common::seconds_between(common::Stamp::now(), started_);
+  cpu_cores_ = wall_s_ > 0.0 ? (process_cpu_seconds() - cpu_at_start_s_) / wall_s_ : 0.0;
+}
+
+bool Pipeline::succeeded() const {
+  const bool mapped = !rig_->has_camera() || mapping_->stats().scans > 0;
+  return estimation_->stats().initialised && mapped;
 }
 
 bool Pipeline::has_taken(const HandedOver& handed) const {
@@ -210,6 +220,8 @@ std::vector<std::string> Pipeline::summary() const {
   rig_->summary(lines);
   for (const PipelineObserver* o : observers_) o->summary(lines);
   ring_summary(rings(), lines);
+  lines.push_back(
+      fmt::format("cpu              : {:.2f} cores over {:.1f} s", cpu_cores_, wall_s_));
   return lines;
 }
 

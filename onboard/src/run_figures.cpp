@@ -1,6 +1,7 @@
 #include "semap/onboard/run_figures.hpp"
 
 #include <spdlog/fmt/fmt.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
@@ -36,6 +37,15 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
                        perception->latency().percentiles()});
   }
   return figures;
+}
+
+double process_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
 std::string Progress::line(double t, const EstimationStageStats& est,

@@ -145,16 +145,16 @@ void SimReport::summary(std::vector<std::string>& lines) const {
                   accuracy_.rmse(), accuracy_.max(), accuracy_.count()));
 }
 
-std::filesystem::path SimReport::write(onboard::Pipeline& pipeline, const std::string& segmenter,
-                                       double cpu_cores_used) const {
+std::filesystem::path SimReport::write(onboard::Pipeline& pipeline) const {
   RunFigures figures;
-  figures.segmenter = segmenter;
+  const bool onnx = pipeline.config().segmenter.kind == onboard::SegmenterConfig::Kind::kOnnx;
+  figures.segmenter = onnx ? "onnx" : "palette";
   if (accuracy_.any()) figures.pose_rmse_m = accuracy_.rmse();
   figures.frames_captured = rig_.camera().rendered();
   figures.frames_mapped = pipeline.mapping().scans;
   figures.latency_frame_to_map = pipeline.mapping_stage().latency().percentiles();
   figures.ring_drops = pipeline.ring_drops();
-  figures.cpu_cores_used = cpu_cores_used;
+  figures.cpu_cores_used = pipeline.cpu_cores();
   return write(figures, pipeline.map(), pipeline.estimation());
 }
 

@@ -94,6 +94,12 @@ class Pipeline {
   void save_map(const std::filesystem::path& path);
   // After stop(): the exit summary, one line per part (tests read them).
   std::vector<std::string> summary() const;
+  // After stop(): the process's CPU time over the run's wall time, in cores.
+  double cpu_cores() const { return cpu_cores_; }
+  // After stop(): whether the run did its job: the filter initialised and, when the rig has a
+  // camera, something was mapped.
+  bool succeeded() const;
+  const OnboardConfig& config() const { return config_; }
 
  private:
   // Fast replay: true once the stages have taken all that the rig handed over.
@@ -118,6 +124,9 @@ class Pipeline {
   HealthMonitor health_;
   Progress progress_;
   common::Stamp started_;
+  double cpu_at_start_s_ = 0.0;
+  double cpu_cores_ = 0.0;
+  double wall_s_ = 0.0;
   common::Stamp next_health_;
   common::Stamp next_progress_;
   bool frame_recorded_ = false;

@@ -80,8 +80,7 @@ class SimReport final : public onboard::PipelineObserver {
   void summary(std::vector<std::string>& lines) const override;
 
   // Writes the files of the stopped pipeline's run; returns summary.json's path.
-  std::filesystem::path write(onboard::Pipeline& pipeline, const std::string& segmenter,
-                              double cpu_cores_used) const;
+  std::filesystem::path write(onboard::Pipeline& pipeline) const;
 
   const std::filesystem::path& dir() const { return dir_; }
 
