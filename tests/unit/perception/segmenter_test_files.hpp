@@ -1,44 +1,12 @@
 #pragma once
 
-// Files the segmenter tests write: a private temporary folder, model cards, text files.
+// The model cards the segmenter tests write (folders and text files: test_files.hpp).
 
-#include <gtest/gtest.h>
-#include <unistd.h>
-
-#include <filesystem>
-#include <fstream>
-#include <functional>
 #include <string>
 
+#include "test_files.hpp"
+
 namespace semap::perception::testing {
-
-// A fresh folder per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            ("semap_seg_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-             std::to_string(::getpid()));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  std::filesystem::path path_;
-};
-
-inline std::filesystem::path write_text(const std::filesystem::path& path,
-                                        const std::string& text) {
-  std::ofstream(path) << text;
-  return path;
-}
 
 // A model card for a three-class network "net.onnx"; its lines are numbered in the comments
 // so tests can check the line an error names.
@@ -75,17 +43,6 @@ inline std::string card_yaml(const CardFields& f) {
          "  unmapped: " + f.unmapped + "\n" +                           // 15
          "  from_model: " + f.from_model + "\n";                        // 16
   // clang-format on
-}
-
-// The message of the exception `f` throws, or "" when it throws none.
-template <typename Exception>
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Exception& e) {
-    return e.what();
-  }
-  return "";
 }
 
 }  // namespace semap::perception::testing
