@@ -2,7 +2,9 @@
 
 #include <linux/videodev2.h>
 
+#include <cstring>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "semap/drivers/jpeg_decoder.hpp"
 
@@ -110,6 +112,29 @@ cv::Mat to_mat(const common::ImageFrame& frame, JpegDecoder& jpeg) {
       break;
   }
   return {};
+}
+
+common::ImageFrame to_frame(const cv::Mat& image, common::PixelFormat format, common::Stamp stamp,
+                            std::uint32_t sequence) {
+  const int type = format == common::PixelFormat::kBgr24  ? CV_8UC3
+                   : format == common::PixelFormat::kGrey ? CV_8UC1
+                   : format == common::PixelFormat::kZ16  ? CV_16UC1
+                                                          : -1;
+  if (type < 0 || image.type() != type) {
+    throw std::invalid_argument("to_frame: the image's type does not match the pixel format");
+  }
+  common::ImageFrame f;
+  f.stamp = stamp;
+  f.sequence = sequence;
+  f.format = format;
+  f.width = static_cast<std::uint32_t>(image.cols);
+  f.height = static_cast<std::uint32_t>(image.rows);
+  f.stride = static_cast<std::uint32_t>(image.cols * image.elemSize());
+  f.data.resize(static_cast<std::size_t>(f.stride) * f.height);
+  for (int v = 0; v < image.rows; ++v) {
+    std::memcpy(f.data.data() + static_cast<std::size_t>(v) * f.stride, image.ptr(v), f.stride);
+  }
+  return f;
 }
 
 }  // namespace semap::drivers

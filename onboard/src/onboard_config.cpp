@@ -150,12 +150,13 @@ void read_depth(const ConfigSection& s, const CameraConfig& camera, DepthConfig&
 }
 
 void read_segmenter(const ConfigSection& s, SegmenterConfig& seg) {
-  seg.kind = s.get_choice("kind", "palette", {"onnx", "palette"}) == "onnx"
-                 ? SegmenterConfig::Kind::kOnnx
-                 : SegmenterConfig::Kind::kPalette;
+  const std::string kind = s.get_choice("kind", "palette", {"onnx", "palette", "geometry"});
+  seg.kind = kind == "onnx"       ? SegmenterConfig::Kind::kOnnx
+             : kind == "geometry" ? SegmenterConfig::Kind::kGeometry
+                                  : SegmenterConfig::Kind::kPalette;
   if (seg.kind == SegmenterConfig::Kind::kOnnx) {
     seg.model_card = std::filesystem::absolute(s.get<std::string>("model_card"));
-  } else {
+  } else if (seg.kind == SegmenterConfig::Kind::kPalette) {
     if (s.has("palette")) seg.palette = std::filesystem::absolute(s.get<std::string>("palette"));
     seg.confidence = static_cast<float>(s.get_in_range("confidence", seg.confidence, 0.01, 1.0));
   }

@@ -52,7 +52,7 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
       depth_ring_(config.depth.ring, OverflowPolicy::kDropOldest),
       cloud_ring_(config.depth.ring, OverflowPolicy::kDropOldest),
       poses_(config.estimator.history),
-      rig_(make_rig(SensorRings{imu_ring_, gnss_ring_, colour_ring_, depth_ring_})) {
+      rig_(make_rig(SensorRings{imu_ring_, gnss_ring_, colour_ring_, depth_ring_, poses_})) {
   auto log = common::logger("onboard");
   const bool inekf = config_.estimator.filter == estimation::FilterKind::kLeftInekf;
   log->info(
@@ -175,7 +175,7 @@ void Pipeline::stop() {
 
 bool Pipeline::succeeded() const {
   const bool mapped = !rig_->has_camera() || mapping_->stats().scans > 0;
-  return estimation_->stats().initialised && mapped;
+  return (rig_->gives_poses() || estimation_->stats().initialised) && mapped;
 }
 
 bool Pipeline::has_taken(const HandedOver& handed) const {
@@ -213,7 +213,7 @@ std::vector<std::pair<std::string, std::uint64_t>> Pipeline::ring_drops() const 
 std::vector<std::string> Pipeline::summary() const {
   std::vector<std::string> lines;
   rig_->drivers().summary(lines);
-  estimation_summary(estimation_->stats(), lines);
+  if (!rig_->gives_poses()) estimation_summary(estimation_->stats(), lines);
   if (perception_) perception_summary(*perception_, lines);
   mapping_summary(mapping_->stats(), checkpoint_path_, config_.map.memory_radius_m, lines);
   if (dds_) dds_summary(*dds_, lines);

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "semap/common/config.hpp"
+#include "semap/perception/geometry_segmenter.hpp"
 #include "semap/perception/model_card.hpp"
 #include "semap/perception/onnx_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
@@ -29,6 +30,9 @@ std::unique_ptr<perception::Segmenter> make_segmenter(const SegmenterConfig& con
   if (config.kind == SegmenterConfig::Kind::kOnnx) {
     return std::make_unique<perception::OnnxSegmenter>(
         load_card_for_map(config.model_card, map_classes));
+  }
+  if (config.kind == SegmenterConfig::Kind::kGeometry) {
+    return std::make_unique<perception::GeometrySegmenter>(map_classes);
   }
   perception::PaletteOptions options;
   options.confidence = config.confidence;

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <opencv2/core.hpp>
 
 #include "semap/common/logging.hpp"
 #include "semap/drivers/driver_error.hpp"
+#include "semap/drivers/frame_convert.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 
 namespace semap::sim {
@@ -14,22 +14,6 @@ namespace semap::sim {
 namespace {
 
 constexpr std::size_t kTruthKept = 64;  // frames: more than the perception stage holds
-
-common::ImageFrame to_frame(const cv::Mat& image, common::PixelFormat format, common::Stamp stamp,
-                            std::uint32_t sequence) {
-  common::ImageFrame f;
-  f.stamp = stamp;
-  f.sequence = sequence;
-  f.format = format;
-  f.width = static_cast<std::uint32_t>(image.cols);
-  f.height = static_cast<std::uint32_t>(image.rows);
-  f.stride = static_cast<std::uint32_t>(image.cols * image.elemSize());
-  f.data.resize(static_cast<std::size_t>(f.stride) * f.height);
-  for (int v = 0; v < image.rows; ++v) {
-    std::memcpy(f.data.data() + static_cast<std::size_t>(v) * f.stride, image.ptr(v), f.stride);
-  }
-  return f;
-}
 
 // Each pixel in its train id's Cityscapes colour (BGR), black where the id has none.
 cv::Mat paint_classes(const cv::Mat& train_ids) {
@@ -149,14 +133,14 @@ void SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std
                             std::stop_token stop) {
   const cv::Mat colour = image_ == SimCameraImage::kRgb ? frame.bgr : paint_classes(frame.labels);
   if (!output_.device) {
-    colour_ring_.try_push(to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+    colour_ring_.try_push(drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
   } else if (!show(colour, stamp, stop)) {
     std::lock_guard lock(mutex_);
     ++not_shown_;
     return;
   }
-  depth_ring_.try_push(to_frame(sim::depth_to_z16(frame.depth_m, depth_scale_),
-                                common::PixelFormat::kZ16, stamp, sequence));
+  depth_ring_.try_push(drivers::to_frame(sim::depth_to_z16(frame.depth_m, depth_scale_),
+                                         common::PixelFormat::kZ16, stamp, sequence));
 }
 
 // Writes the frame to the output `period - tolerance` before its stamp (see SimCameraOutput);

@@ -24,6 +24,10 @@ inline constexpr std::uint32_t kMaxImageSide = 16384;
 // JPEG is corrupt or the JPEG's header gives another size than the frame's width and height.
 cv::Mat to_mat(const common::ImageFrame& frame, JpegDecoder& jpeg);
 
+// The inverse for raw formats: an image (CV_8UC3 as kBgr24, CV_8UC1 as kGrey, CV_16UC1 as kZ16)
+// as a frame, rows packed. Throws std::invalid_argument when the type does not match the format.
+common::ImageFrame to_frame(const cv::Mat& image, common::PixelFormat format, common::Stamp stamp,
+                            std::uint32_t sequence);
 // Bytes a complete raw frame needs (stride * height); 0 for compressed formats.
 std::size_t expected_size(const common::ImageFrame& frame);
 

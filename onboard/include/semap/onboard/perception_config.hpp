@@ -47,7 +47,8 @@ perception::StereoCalibration load_stereo_calibration(const std::filesystem::pat
 
 // segmenter: what labels the pixels.
 struct SegmenterConfig {
-  enum class Kind { kOnnx, kPalette } kind = Kind::kPalette;
+  // kGeometry: no labels, every depth pixel is map class 1 (geometry only).
+  enum class Kind { kOnnx, kPalette, kGeometry } kind = Kind::kPalette;
   std::filesystem::path model_card;  // onnx
   // palette: YAML file; empty = the Cityscapes colours of the simulated world's classes
   std::filesystem::path palette;

@@ -8,15 +8,19 @@
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/onboard/rig_drivers.hpp"
+#include "semap/onboard/shared_pose_history.hpp"
 
 namespace semap::onboard {
 
-// The rings a sensor rig fills; the pipeline owns them and its stages drain them.
+// The rings a sensor rig fills; the pipeline owns them and its stages drain them. A rig that
+// knows its poses (a dataset with ground truth) appends them to `poses` itself, each before
+// the frame taken at it; the others leave the history to the estimation stage.
 struct SensorRings {
   common::SpscRing<common::ImuSample>& imu;
   common::SpscRing<common::GnssFix>& gnss;
   common::SpscRing<common::ImageFrame>& colour;
   common::SpscRing<common::ImageFrame>& depth;
+  SharedPoseHistory& poses;
 };
 
 // What a rig has handed to the pipeline so far.
@@ -37,6 +41,9 @@ class SensorRig {
   virtual std::string describe() const = 0;
   // Whether colour frames come (without them the robot localises and its map stays empty).
   virtual bool has_camera() const = 0;
+  // Whether the rig gives the poses of its frames (SensorRings::poses) instead of the IMU and
+  // GNSS streams the estimation stage turns into poses.
+  virtual bool gives_poses() const { return false; }
   // Pipeline stamp minus the sensors' own stamp (a recording played back now); 0 for live ones.
   virtual std::int64_t stamp_offset_ns() const { return 0; }
   // The raw streams as they arrive; set before start(). Throws when the rig has none to give.

@@ -1,0 +1,80 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <atomic>
+#include <cstddef>
+#include <limits>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "semap/onboard/sensor_rig.hpp"
+#include "semap/perception/datasets/rgbd_sequence.hpp"
+
+namespace semap::onboard {
+
+// Which frames of a dataset to play: first, first + stride, ... up to last (indices into the
+// sequence's frames).
+struct DatasetSelection {
+  std::size_t first = 0;
+  std::size_t last = std::numeric_limits<std::size_t>::max();
+  std::size_t stride = 1;
+};
+
+// Plays a recorded RGB-D dataset (TUM, Redwood: perception::datasets::RgbdSequence) through the
+// pipeline's own perception and mapping stages, as fast as they take it. For each frame the
+// dataset's pose goes into the pose history, then the depth image (raw units, Z16) and the
+// colour image into their rings, stamped with the time they are handed over; the next frame
+// waits until the stages have mapped this one or counted it as dropped with a reason (pace_by),
+// so a run maps every frame it can, and the same map every time. The body frame is the
+// configured camera mount's: a frame's body pose is its camera pose times optical-from-body.
+// A frame whose image cannot be read, or whose depth image is not 16-bit, is named and counted
+// (problems()) and skipped.
+class DatasetRig final : public SensorRig {
+ public:
+  DatasetRig(perception::datasets::RgbdSequence sequence, std::string name,
+             const Eigen::Isometry3f& body_from_optical, DatasetSelection selection,
+             const SensorRings& rings);
+  ~DatasetRig() override;
+  DatasetRig(const DatasetRig&) = delete;
+  DatasetRig& operator=(const DatasetRig&) = delete;
+
+  std::string describe() const override;
+  bool has_camera() const override { return true; }
+  bool gives_poses() const override { return true; }
+  // A dataset has no raw device streams to record: throws.
+  void set_taps(RawTaps taps) override;
+  void pace_by(Taken taken) override { taken_ = std::move(taken); }
+  void start() override;
+  void stop() override;
+  bool finished() const override { return finished_.load(std::memory_order_acquire); }
+  const RigDrivers& drivers() const override { return drivers_; }
+  void summary(std::vector<std::string>& lines) const override;
+
+  // Frames selected, and of those handed to the pipeline.
+  std::size_t selected() const { return selected_.size(); }
+  std::size_t handed_over() const { return handed_.load(std::memory_order_acquire); }
+  // The reader's problems and the frames this rig could not read, each naming its file.
+  std::vector<perception::datasets::InputProblem> problems() const;
+
+ private:
+  void run(std::stop_token stop);
+  bool hand_over(const perception::datasets::RgbdFrame& frame, std::uint32_t sequence);
+  void problem(const std::filesystem::path& file, const std::string& what);
+
+  perception::datasets::RgbdSequence sequence_;
+  std::string name_;
+  Eigen::Isometry3d optical_from_body_;
+  std::vector<std::size_t> selected_;
+  SensorRings rings_;
+  RigDrivers drivers_;
+  Taken taken_;
+  mutable std::mutex mutex_;  // problems_
+  std::vector<perception::datasets::InputProblem> problems_;
+  std::atomic<std::size_t> handed_{0};
+  std::atomic<bool> finished_{false};
+  std::jthread thread_;
+};
+
+}  // namespace semap::onboard
