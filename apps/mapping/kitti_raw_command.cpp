@@ -193,7 +193,7 @@ int run(const CLI::App& command, const RawOptions& o) {
       o.segmenter.empty() ? make_label_image_source(o.labels, params.num_classes)
                           : make_model_label_source(o.segmenter, drive_dir / "image_02" / "data");
   params.num_classes = labels->num_classes();
-  params.validate();
+  params.validate_semantic();
 
   est::OxtsData oxts;
   try {

@@ -23,12 +23,11 @@ struct LogOddsRun {
   mapping::SourceId robot = 1;
 };
 
-inline mapping::LayeredMapParams logodds_params(const mapping::MapParams& bki) {
-  mapping::LayeredMapParams p;
+// The S-BKI parameters as a log-odds map's: the same grid and classes, the S-BKI max range
+// (when set) as the log-odds one.
+inline mapping::MapParams logodds_params(const mapping::MapParams& bki) {
+  mapping::MapParams p = bki;
   p.method = mapping::MapMethod::kLogOdds;
-  p.resolution = bki.resolution;
-  p.block_depth = bki.block_depth;
-  p.num_classes = bki.num_classes;
   if (bki.max_range > 0.0f) p.logodds.max_range = bki.max_range;
   return p;
 }

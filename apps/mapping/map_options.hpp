@@ -64,7 +64,7 @@ inline mapping::MapParams resolve_map_params(const CLI::App& app, const MapOptio
   if (given("--ds-res")) p.ds_res = f.ds_res;
   if (given("--max-range")) p.max_range = f.max_range;
   if (given("--unknown-variance")) p.unknown_variance = f.unknown_variance;
-  p.validate();
+  p.validate_semantic();
   return p;
 }
 

@@ -24,9 +24,8 @@ using semap::common::LabeledCloud;
 using semap::map_io::occupied_agreement;
 using semap::mapping::LayeredMap;
 
-LayeredMap build(const semap::mapping::LayeredMapParams& params,
-                 const std::vector<LabeledCloud>& scans, semap::mapping::SourceId robot,
-                 const Eigen::Isometry3d& T) {
+LayeredMap build(const semap::mapping::MapParams& params, const std::vector<LabeledCloud>& scans,
+                 semap::mapping::SourceId robot, const Eigen::Isometry3d& T) {
   semap::mapping::LogOddsMap map(params, robot);
   for (const auto& scan : scans) map.insert(semap::mapping::transform_cloud(scan, T.cast<float>()));
   return map.layers();
@@ -49,7 +48,7 @@ int main(int argc, char** argv) {
   std::size_t split = 6;
   // Yaw 30 degrees about z and a translation off the 0.1 m grid.
   std::vector<double> b_frame = {2.013, -1.347, 0.518, 0.9659258, 0.0, 0.0, 0.2588190};
-  semap::mapping::LayeredMapParams params;
+  semap::mapping::MapParams params;
   params.method = semap::mapping::MapMethod::kLogOdds;
   params.logodds.max_range = 8.0;
   app.add_option("scans", scan_paths, "labelled PCD scans in order")->required();
@@ -64,7 +63,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    semap::mapping::validate(params);
+    params.validate();
     if (split == 0 || split >= scan_paths.size()) {
       throw std::invalid_argument("--split must leave scans for both robots");
     }

@@ -15,14 +15,14 @@ namespace {
 
 using semap::common::BlockIndex;
 using semap::mapping::LayeredMap;
-using semap::mapping::LayeredMapParams;
+using semap::mapping::MapParams;
 
-LayeredMapParams params() {
+MapParams params() {
   semap::dds_idl::MapDescription d;
   d.resolution = 0.1f;
   d.block_cells = 8;
   d.num_classes = 4;
-  return semap::fusion::layered_params(d, semap::mapping::MapMethod::kBki, 0.001);
+  return semap::fusion::map_params_of(d, semap::mapping::MapMethod::kBki, 0.001);
 }
 
 // A robot map of `blocks` 8^3 blocks in a square patch on the ground, random evidence.

@@ -31,8 +31,8 @@ const std::vector<semap::common::LabeledCloud>& toy_scans() {
   return scans;
 }
 
-semap::mapping::LayeredMapParams toy_params() {
-  semap::mapping::LayeredMapParams p;
+semap::mapping::MapParams toy_params() {
+  semap::mapping::MapParams p;
   p.method = semap::mapping::MapMethod::kLogOdds;
   p.num_classes = 4;
   p.logodds.max_range = 8.0;

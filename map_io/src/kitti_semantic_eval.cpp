@@ -71,7 +71,7 @@ std::vector<std::uint16_t> flipped_truth(const std::vector<std::uint16_t>& truth
 }
 
 void check(const KittiSemanticConfig& config) {
-  config.params.validate();
+  config.params.validate_semantic();
   if (config.params.num_classes != kKittiClasses) {
     throw std::invalid_argument("SemanticKITTI maps need num_classes 20, not " +
                                 std::to_string(config.params.num_classes));

@@ -9,13 +9,13 @@ namespace semap::map_io {
 
 Agreement occupied_agreement(const mapping::LayeredMap& reference,
                              const mapping::LayeredMap& candidate) {
-  const mapping::LayeredMapParams& pr = reference.params();
-  const mapping::LayeredMapParams& pc = candidate.params();
+  const mapping::MapParams& pr = reference.params();
+  const mapping::MapParams& pc = candidate.params();
   if (pr.method != pc.method || pr.num_classes != pc.num_classes ||
       pr.resolution != pc.resolution || pr.block_depth != pc.block_depth) {
     throw std::invalid_argument("occupied_agreement: maps differ in method, classes or grid");
   }
-  const int side = pr.block_side();
+  const int side = pr.cells_per_side();
   const auto channels = static_cast<std::size_t>(pr.channels());
   Agreement a;
   std::vector<float> ref_block;

@@ -25,8 +25,8 @@ void append_text(std::vector<std::uint8_t>& out, const std::string& text) {
 }  // namespace
 
 std::vector<OccupiedCell> occupied_cells(const mapping::LayeredMap& map) {
-  const mapping::LayeredMapParams& p = map.params();
-  const int side = p.block_side();
+  const mapping::MapParams& p = map.params();
+  const int side = p.cells_per_side();
   const common::MapGrid grid = p.grid();
   const auto channels = static_cast<std::size_t>(p.channels());
   std::vector<OccupiedCell> cells;

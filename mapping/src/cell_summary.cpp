@@ -8,8 +8,7 @@
 
 namespace semap::mapping {
 
-std::vector<double> class_probabilities(const LayeredMapParams& params,
-                                        std::span<const float> fused) {
+std::vector<double> class_probabilities(const MapParams& params, std::span<const float> fused) {
   std::vector<double> p(static_cast<std::size_t>(params.num_classes));
   if (params.method == MapMethod::kLogOdds) {
     LogOddsModel::probabilities(fused.subspan(1), p);
@@ -20,7 +19,7 @@ std::vector<double> class_probabilities(const LayeredMapParams& params,
   return p;
 }
 
-CellSummary summarize(const LayeredMapParams& params, std::span<const float> fused) {
+CellSummary summarize(const MapParams& params, std::span<const float> fused) {
   CellSummary s;
   const std::vector<double> p = class_probabilities(params, fused);
   const auto best = std::max_element(p.begin(), p.end());
@@ -35,13 +34,10 @@ CellSummary summarize(const LayeredMapParams& params, std::span<const float> fus
   }
   // S-BKI / S-CSM: fused channels are alpha = alpha_0 + evidence, read with a zero prior, and
   // cells more uncertain than the map's own threshold are unknown, as on the robot.
-  const auto prior = static_cast<float>(params.prior);
-  const auto threshold = params.extra.find("bki.unknown_variance");
-  const float unknown_variance =
-      threshold == params.extra.end() ? 0.0f : static_cast<float>(threshold->second);
+  const float prior = params.prior;
   const common::CellPosterior cell(
       fused, 0.0f, std::any_of(fused.begin(), fused.end(), [&](float v) { return v > prior; }));
-  const common::CellState state = cell.state(unknown_variance);
+  const common::CellState state = cell.state(params.unknown_variance);
   s.known = state != common::CellState::kUnknown;
   s.occupied = state == common::CellState::kOccupied;
   s.occupancy = static_cast<float>(1.0 - p[0]);

@@ -46,18 +46,22 @@ std::vector<common::BlockIndex> blocks_between(const common::CellIndex& first,
   return out;
 }
 
-Eigen::Vector3d block_origin(const common::BlockIndex& key, const LayeredMapParams& p) {
-  return Eigen::Vector3d(key.x, key.y, key.z) * p.block_size();
+// Block edge in m, computed in double as resample_layer does.
+double block_edge(const MapParams& p) {
+  return static_cast<double>(p.resolution) * p.cells_per_side();
+}
+
+Eigen::Vector3d block_origin(const common::BlockIndex& key, const MapParams& p) {
+  return Eigen::Vector3d(key.x, key.y, key.z) * block_edge(p);
 }
 
 }  // namespace
 
-std::vector<common::BlockIndex> touched_blocks(const common::BlockIndex& key,
-                                               const LayeredMapParams& from,
-                                               const LayeredMapParams& to,
+std::vector<common::BlockIndex> touched_blocks(const common::BlockIndex& key, const MapParams& from,
+                                               const MapParams& to,
                                                const Eigen::Isometry3d& T_to_from) {
   const Eigen::Vector3d lo = block_origin(key, from);
-  const Box box = transformed_box(lo, lo + Eigen::Vector3d::Constant(from.block_size()), T_to_from);
+  const Box box = transformed_box(lo, lo + Eigen::Vector3d::Constant(block_edge(from)), T_to_from);
   // Target cells whose centre lies in [box.min, box.max).
   const auto first = [&](double v) {
     return static_cast<int>(std::ceil(v / to.resolution - 0.5 - kMargin));
@@ -66,18 +70,18 @@ std::vector<common::BlockIndex> touched_blocks(const common::BlockIndex& key,
     return static_cast<int>(std::ceil(v / to.resolution - 0.5 + kMargin)) - 1;
   };
   return blocks_between({first(box.min.x()), first(box.min.y()), first(box.min.z())},
-                        {last(box.max.x()), last(box.max.y()), last(box.max.z())}, to.block_side());
+                        {last(box.max.x()), last(box.max.y()), last(box.max.z())},
+                        to.cells_per_side());
 }
 
-std::vector<common::BlockIndex> source_blocks(const common::BlockIndex& key,
-                                              const LayeredMapParams& from,
-                                              const LayeredMapParams& to,
+std::vector<common::BlockIndex> source_blocks(const common::BlockIndex& key, const MapParams& from,
+                                              const MapParams& to,
                                               const Eigen::Isometry3d& T_to_from) {
   // The target block's cell centres span the block shrunk by half a cell on every side.
   const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * to.resolution);
   const Eigen::Vector3d lo = block_origin(key, to) + half;
   const Eigen::Vector3d hi =
-      block_origin(key, to) + Eigen::Vector3d::Constant(to.block_size()) - half;
+      block_origin(key, to) + Eigen::Vector3d::Constant(block_edge(to)) - half;
   const Box box = transformed_box(lo, hi, T_to_from.inverse());
   const auto first = [&](double v) {
     return static_cast<int>(std::floor(v / from.resolution - kMargin));
@@ -87,13 +91,13 @@ std::vector<common::BlockIndex> source_blocks(const common::BlockIndex& key,
   };
   return blocks_between({first(box.min.x()), first(box.min.y()), first(box.min.z())},
                         {last(box.max.x()), last(box.max.y()), last(box.max.z())},
-                        from.block_side());
+                        from.cells_per_side());
 }
 
 void remerge_blocks(LayeredMap& fused, SourceId source, const EvidenceGrid& layer,
-                    const LayeredMapParams& from, const std::vector<common::BlockIndex>& targets,
+                    const MapParams& from, const std::vector<common::BlockIndex>& targets,
                     const Eigen::Isometry3d& T_to_from) {
-  const LayeredMapParams& to = fused.params();
+  const MapParams& to = fused.params();
   EvidenceGrid needed(layer.block_side(), layer.channels());
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> taken;
   for (const auto& target : targets) {

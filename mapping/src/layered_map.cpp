@@ -8,7 +8,7 @@
 
 namespace semap::mapping {
 
-LayeredMap::LayeredMap(const LayeredMapParams& params) : params_(params) { validate(params_); }
+LayeredMap::LayeredMap(const MapParams& params) : params_(params) { params_.validate(); }
 
 EvidenceGrid& LayeredMap::layer(SourceId source) {
   auto it = layers_.find(source);
@@ -22,7 +22,7 @@ const EvidenceGrid* LayeredMap::find_layer(SourceId source) const {
 }
 
 void LayeredMap::set_layer(SourceId source, EvidenceGrid grid) {
-  if (grid.block_side() != params_.block_side() || grid.channels() != params_.channels()) {
+  if (grid.block_side() != params_.cells_per_side() || grid.channels() != params_.channels()) {
     throw std::invalid_argument("LayeredMap::set_layer: layer geometry differs from the map");
   }
   layers_.insert_or_assign(source, std::move(grid));
@@ -37,7 +37,7 @@ void LayeredMap::finish_fusion(std::span<float> out) const {
     const LogOddsModel model(params_.logodds);
     out[0] = model.clamp(out[0]);
   } else {
-    for (float& alpha : out) alpha += static_cast<float>(params_.prior);
+    for (float& alpha : out) alpha += params_.prior;
   }
 }
 
@@ -55,8 +55,7 @@ bool LayeredMap::fused(const common::CellIndex& cell, std::span<float> out) cons
 }
 
 bool LayeredMap::fused_block(const common::BlockIndex& key, std::vector<float>& out) const {
-  const auto cells =
-      static_cast<std::size_t>(params_.block_side() * params_.block_side() * params_.block_side());
+  const auto cells = static_cast<std::size_t>(params_.cells_per_block());
   out.assign(cells * static_cast<std::size_t>(params_.channels()), 0.0f);
   bool any = false;
   for (const auto& [source, grid] : layers_) {

@@ -21,7 +21,7 @@ using CellSet = std::unordered_set<common::CellIndex, CellHash>;
 
 }  // namespace
 
-LogOddsMap::LogOddsMap(const LayeredMapParams& params, SourceId robot)
+LogOddsMap::LogOddsMap(const MapParams& params, SourceId robot)
     : LogOddsMap(LayeredMap(params), robot) {}
 
 LogOddsMap::LogOddsMap(LayeredMap map, SourceId robot)
@@ -33,7 +33,7 @@ LogOddsMap::LogOddsMap(LayeredMap map, SourceId robot)
 }
 
 LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
-  const LayeredMapParams& p = map_.params();
+  const MapParams& p = map_.params();
   const auto k = static_cast<std::size_t>(p.num_classes);
   if (cloud.has_probabilities() ? cloud.probabilities.size() != cloud.size() * k
                                 : cloud.labels.size() != cloud.size()) {
@@ -48,7 +48,7 @@ LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
                                 std::to_string(k));
   }
   EvidenceGrid& grid = map_.layer(robot_);
-  const auto inv_res = static_cast<float>(1.0 / p.resolution);
+  const float inv_res = 1.0f / p.resolution;
   // Cells the block table can hold; a beam between two of them stays within them.
   const auto storable = [&](const Eigen::Vector3d& point) {
     return detail::mappable(point.cast<float>(), inv_res);

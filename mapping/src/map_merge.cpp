@@ -18,16 +18,16 @@ bool any_nonzero(std::span<const float> values) {
 
 }  // namespace
 
-EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& from_params,
-                            const LayeredMapParams& to_params, const Eigen::Isometry3d& T_to_from) {
+EvidenceGrid resample_layer(const EvidenceGrid& layer, const MapParams& from_params,
+                            const MapParams& to_params, const Eigen::Isometry3d& T_to_from) {
   if (is_identity(T_to_from) && from_params.resolution == to_params.resolution &&
-      from_params.block_side() == to_params.block_side()) {
+      from_params.cells_per_side() == to_params.cells_per_side()) {
     return layer;
   }
-  EvidenceGrid out(to_params.block_side(), to_params.channels());
+  EvidenceGrid out(to_params.cells_per_side(), to_params.channels());
   out.set_updates(layer.updates());
   const Eigen::Isometry3d T_from_to = T_to_from.inverse();
-  const int side = from_params.block_side();
+  const int side = from_params.cells_per_side();
   const double from_res = from_params.resolution;
   const common::MapGrid from_grid = from_params.grid();
   const common::MapGrid to_grid = to_params.grid();
@@ -78,8 +78,8 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& f
 }
 
 MergeReport merge_into(LayeredMap& a, const LayeredMap& b, const Eigen::Isometry3d& T_ab) {
-  const LayeredMapParams& pa = a.params();
-  const LayeredMapParams& pb = b.params();
+  const MapParams& pa = a.params();
+  const MapParams& pb = b.params();
   if (pa.method != pb.method || pa.num_classes != pb.num_classes) {
     throw std::invalid_argument("merge: cannot merge a " + to_string(pb.method) + " map of " +
                                 std::to_string(pb.num_classes) + " classes into a " +

@@ -19,8 +19,8 @@
 namespace semap::mapping {
 
 SemanticMap::SemanticMap(const MapParams& params, SourceId robot)
-    : params_((params.validate(), params)),
-      layers_(layered_params(params)),
+    : params_((params.validate_semantic(), params)),
+      layers_(params),
       robot_(robot),
       grid_(&layers_.layer(robot)),
       inserter_(std::make_unique<detail::TileInserter>(params)) {

@@ -9,7 +9,9 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <optional>
+#include <set>
 
 #include "semap/mapping/atomic_file.hpp"
 
@@ -97,12 +99,17 @@ class Reader {
   std::size_t offset_ = 0;
 };
 
+// The header's named parameters, all written for every map. Older files of version 1 lack the
+// bki.* ones unless SemanticMap built the map; a name missing from a file keeps its MapParams
+// default. A name not listed here is an error: a setting this reader does not know could change
+// what the evidence means, so a new setting needs a new version (docs/map-files.md).
+template <typename Owner, typename T>
 struct NamedParameter {
   const char* name;
-  double LogOddsParams::*field;
+  T Owner::*field;
 };
 
-constexpr std::array<NamedParameter, 7> kLogOddsParameters = {{
+constexpr std::array<NamedParameter<LogOddsParams, double>, 7> kLogOddsParameters = {{
     {"logodds.prob_hit", &LogOddsParams::prob_hit},
     {"logodds.prob_miss", &LogOddsParams::prob_miss},
     {"logodds.clamp_min", &LogOddsParams::clamp_min},
@@ -112,30 +119,45 @@ constexpr std::array<NamedParameter, 7> kLogOddsParameters = {{
     {"logodds.max_range", &LogOddsParams::max_range},
 }};
 
+// Alphabetical, the order files written so far have them in.
+constexpr std::array<NamedParameter<MapParams, float>, 6> kBkiParameters = {{
+    {"bki.ds_res", &MapParams::ds_res},
+    {"bki.ell", &MapParams::ell},
+    {"bki.free_res", &MapParams::free_res},
+    {"bki.max_range", &MapParams::max_range},
+    {"bki.sf2", &MapParams::sf2},
+    {"bki.unknown_variance", &MapParams::unknown_variance},
+}};
+
+template <typename Table>
+auto find_parameter(const Table& table, const std::string& name) {
+  return std::find_if(table.begin(), table.end(), [&](const auto& p) { return name == p.name; });
+}
+
 void encode_header(Writer& w, const LayeredMap& map) {
-  const LayeredMapParams& p = map.params();
+  const MapParams& p = map.params();
   w.put_bytes(kMagic.data(), kMagic.size());
   w.put(kSmapVersion);
   w.put(static_cast<std::uint8_t>(p.method));
   w.put(static_cast<std::uint8_t>(p.block_depth));
   w.put(static_cast<std::uint16_t>(p.num_classes));
   w.put(static_cast<std::uint32_t>(p.channels()));
-  w.put(p.resolution);
-  w.put(p.prior);
-  w.put(static_cast<std::uint32_t>(kLogOddsParameters.size() + p.extra.size()));
+  w.put(static_cast<double>(p.resolution));
+  w.put(static_cast<double>(p.prior));
+  w.put(static_cast<std::uint32_t>(kLogOddsParameters.size() + kBkiParameters.size()));
   const auto put_named = [&](std::string_view name, double value) {
     w.put(static_cast<std::uint16_t>(name.size()));
     w.put_bytes(name.data(), name.size());
     w.put(value);
   };
   for (const auto& param : kLogOddsParameters) put_named(param.name, p.logodds.*param.field);
-  for (const auto& [name, value] : p.extra) put_named(name, value);
+  for (const auto& param : kBkiParameters) put_named(param.name, p.*param.field);
   w.put(static_cast<std::uint32_t>(map.layers().size()));
   w.put_crc_since(0);
 }
 
 struct Header {
-  LayeredMapParams params;
+  MapParams params;
   std::uint32_t layers = 0;
 };
 
@@ -158,28 +180,43 @@ Header decode_header(Reader& r) {
   h.params.block_depth = r.get<std::uint8_t>("block depth");
   h.params.num_classes = r.get<std::uint16_t>("class count");
   const auto channels = r.get<std::uint32_t>("channel count");
-  h.params.resolution = r.get<double>("resolution");
-  h.params.prior = r.get<double>("prior");
+  const auto resolution = r.get<double>("resolution");
+  const auto prior = r.get<double>("prior");
   const auto count = r.get<std::uint32_t>("parameter count");
   if (count > kMaxParameters) r.fail("implausible parameter count " + std::to_string(count));
+  std::vector<std::pair<std::string, double>> named;
   for (std::uint32_t i = 0; i < count; ++i) {
     const auto length = r.get<std::uint16_t>("parameter name length");
     const auto name_bytes = r.take(length, "parameter name");
-    const std::string name(name_bytes.begin(), name_bytes.end());
     const auto value = r.get<double>("parameter value");
-    if (!std::isfinite(value)) r.fail("parameter " + name + " is not finite");
-    const auto known = std::find_if(kLogOddsParameters.begin(), kLogOddsParameters.end(),
-                                    [&](const NamedParameter& p) { return name == p.name; });
-    if (known == kLogOddsParameters.end()) {
-      if (!h.params.extra.emplace(name, value).second) r.fail("parameter " + name + " twice");
-    } else {
-      h.params.logodds.*known->field = value;
-    }
+    named.emplace_back(std::string(name_bytes.begin(), name_bytes.end()), value);
   }
   h.layers = r.get<std::uint32_t>("layer count");
   r.check_crc_since(0, "header");
+  // Stored as doubles, held as floats: a value beyond float range is refused by name rather
+  // than becoming inf.
+  const auto to_float = [&](const std::string& name, double value) {
+    if (!(std::isfinite(value) && std::fabs(value) <= std::numeric_limits<float>::max())) {
+      r.fail("header: parameter " + name + " is not finite or beyond float range");
+    }
+    return static_cast<float>(value);
+  };
+  h.params.resolution = to_float("resolution", resolution);
+  h.params.prior = to_float("prior", prior);
+  std::set<std::string> seen;
+  for (const auto& [name, value] : named) {
+    if (!seen.insert(name).second) r.fail("header: parameter " + name + " twice");
+    if (const auto lo = find_parameter(kLogOddsParameters, name); lo != kLogOddsParameters.end()) {
+      if (!std::isfinite(value)) r.fail("header: parameter " + name + " is not finite");
+      h.params.logodds.*lo->field = value;
+    } else if (const auto bki = find_parameter(kBkiParameters, name); bki != kBkiParameters.end()) {
+      h.params.*bki->field = to_float(name, value);
+    } else {
+      r.fail("header: unknown parameter '" + name + "' (known: logodds.* and bki.* settings)");
+    }
+  }
   try {
-    validate(h.params);
+    h.params.validate();
   } catch (const std::invalid_argument& e) {
     r.fail(std::string("header: ") + e.what());
   }

@@ -244,7 +244,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
   if (rig_keys) rig_keys(rig, root, c);
   rig.finish();
   root.finish();
-  c.map.params.validate();
+  c.map.params.validate_semantic();
   return c;
 }
 

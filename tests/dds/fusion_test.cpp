@@ -76,7 +76,7 @@ struct Robot {
     for (const auto& k : keys) out.push_back(robot_block(id, k, offset_x, version));
     return out;
   }
-  mapping::LayeredMap layered(const mapping::LayeredMapParams& p) const {
+  mapping::LayeredMap layered(const mapping::MapParams& p) const {
     mapping::LayeredMap m(p);
     auto& layer = m.layer(static_cast<mapping::SourceId>(id));
     for (const auto& b : blocks(1)) layer.put_block(b.index, evidence_block(b, p));
@@ -107,7 +107,7 @@ Eigen::Isometry3d robot2_pose() {
 class FusionTest : public DdsTest {
  protected:
   FusionTest()
-      : params_(layered_params(description(), mapping::MapMethod::kBki, kPrior)),
+      : params_(map_params_of(description(), mapping::MapMethod::kBki, kPrior)),
         expected_(params_) {
     mapping::merge_into(expected_, kRobot1.layered(params_), Eigen::Isometry3d::Identity());
     mapping::merge_into(expected_, kRobot2.layered(params_), robot2_pose());
@@ -171,7 +171,7 @@ class FusionTest : public DdsTest {
     return false;
   }
 
-  mapping::LayeredMapParams params_;
+  mapping::MapParams params_;
   mapping::LayeredMap expected_;
 };
 

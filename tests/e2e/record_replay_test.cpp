@@ -215,7 +215,7 @@ std::map<std::tuple<int, int, int>, std::vector<float>> evidence_of(const fs::pa
   const auto& params = map.params();
   const semap::common::MapGrid grid = params.grid();
   const auto channels = static_cast<std::size_t>(params.channels());
-  const int side = params.block_side();
+  const int side = params.cells_per_side();
   std::map<std::tuple<int, int, int>, std::vector<float>> cells;
   std::vector<float> block;
   for (const auto& index : map.block_keys()) {

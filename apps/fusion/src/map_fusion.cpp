@@ -26,7 +26,7 @@ dds_idl::MapClientConfig client_config(const std::string& ns, const dds_idl::Map
 
 MapFusion::MapFusion(const dds_idl::Participant& participant, MapFusionConfig config)
     : config_(std::move(config)),
-      params_(layered_params(config_.description, config_.method, config_.prior)),
+      params_(map_params_of(config_.description, config_.method, config_.prior)),
       fused_(params_),
       publisher_(participant, config_.output, config_.description, *this) {
   if (config_.robots.empty()) throw std::invalid_argument("MapFusion: no robots to follow");
@@ -41,7 +41,7 @@ MapFusion::MapFusion(const dds_idl::Participant& participant, MapFusionConfig co
                             static_cast<mapping::SourceId>(i + 1),
                             std::make_unique<dds_idl::MapClient>(
                                 participant, client_config(source.ns, config_.description)),
-                            mapping::EvidenceGrid(params_.block_side(), params_.channels()),
+                            mapping::EvidenceGrid(params_.cells_per_side(), params_.channels()),
                             {},
                             {}});
   }

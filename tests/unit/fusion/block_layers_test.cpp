@@ -16,19 +16,19 @@ dds_idl::MapDescription shape(float resolution, std::uint16_t cells, std::uint16
 }
 
 TEST(BlockLayers, ParamsFollowTheDescription) {
-  const auto p = layered_params(shape(0.2f, 8, 5), mapping::MapMethod::kBki, 0.01);
-  EXPECT_EQ(p.block_side(), 8);
+  const auto p = map_params_of(shape(0.2f, 8, 5), mapping::MapMethod::kBki, 0.01);
+  EXPECT_EQ(p.cells_per_side(), 8);
   EXPECT_EQ(p.block_depth, 4);
   EXPECT_EQ(p.channels(), 5);
-  EXPECT_DOUBLE_EQ(p.resolution, static_cast<double>(0.2f));
-  EXPECT_THROW(layered_params(shape(0.2f, 6, 5), mapping::MapMethod::kBki, 0.01),
+  EXPECT_FLOAT_EQ(p.resolution, 0.2f);
+  EXPECT_THROW(map_params_of(shape(0.2f, 6, 5), mapping::MapMethod::kBki, 0.01),
                std::invalid_argument);
-  EXPECT_THROW(layered_params(shape(0.2f, 8, 5), mapping::MapMethod::kLogOdds, 0.01),
+  EXPECT_THROW(map_params_of(shape(0.2f, 8, 5), mapping::MapMethod::kLogOdds, 0.01),
                std::invalid_argument);
 }
 
 TEST(BlockLayers, EvidenceRoundTripsThroughALayeredMap) {
-  const auto p = layered_params(shape(0.1f, 4, 3), mapping::MapMethod::kBki, 0.5);
+  const auto p = map_params_of(shape(0.1f, 4, 3), mapping::MapMethod::kBki, 0.5);
   auto block = dds_idl::BlockSnapshot::empty({1, -2, 0}, 0.1f, 4, 3, true);
   for (std::size_t i = 0; i < block.evidence.size(); ++i) {
     block.evidence[i] = static_cast<float>(i % 7);

@@ -22,9 +22,9 @@ class Export : public ::testing::Test {
            ("export_test_" + std::to_string(::getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(dir_);
-    LayeredMapParams p;
+    MapParams p;
     p.method = MapMethod::kLogOdds;
-    p.resolution = 0.1;
+    p.resolution = 0.1f;
     p.num_classes = 4;
     LogOddsMap map(p, 1);
     // A floor of class 1 and a wall of class 2, seen from above.

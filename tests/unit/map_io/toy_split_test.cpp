@@ -102,7 +102,7 @@ TEST_F(ToySplit, MergedLogOddsMapAgreesWithSingleRobotMap) {
 // S-BKI evidence is a sum over scans, so merging the two robots' maps (their own layers, as
 // saved) is exact, and merging one twice changes nothing.
 TEST_F(ToySplit, MergedBkiMapEqualsSingleRobotMap) {
-  const LayeredMapParams toy = mapping::testing::toy_logodds_params();
+  const MapParams toy = mapping::testing::toy_logodds_params();
   MapParams p;
   p.resolution = 0.1f;
   p.block_depth = toy.block_depth;

@@ -134,7 +134,7 @@ TEST(EvidenceGrid, TheLiveMapIsItsRobotsLayer) {
   EXPECT_EQ(map.layers().find_layer(4), &map.grid());
   EXPECT_EQ(map.grid().updates(), 3u);
   EXPECT_EQ(map.scans(), 3u);
-  EXPECT_EQ(map.layers().params(), layered_params(params));
+  EXPECT_EQ(map.layers().params(), params);
 
   const SmapReadResult read = decode_smap(encode_smap(map.layers()), "live.smap");
   ASSERT_TRUE(read.complete);

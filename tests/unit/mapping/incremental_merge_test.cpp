@@ -12,13 +12,13 @@
 namespace semap::mapping {
 namespace {
 
-LayeredMapParams params(float resolution, int cells) {
-  LayeredMapParams p;
+MapParams params(float resolution, int cells) {
+  MapParams p;
   p.method = MapMethod::kBki;
   p.resolution = resolution;
   p.block_depth = std::countr_zero(static_cast<unsigned>(cells)) + 1;
   p.num_classes = 2;
-  p.prior = 0.001;
+  p.prior = 0.001f;
   return p;
 }
 
@@ -69,7 +69,7 @@ TEST(IncrementalMerge, BlockRangesCoverWhatResamplingWrites) {
   for (int trial = 0; trial < 40; ++trial) {
     const Eigen::Isometry3d T = random_pose(rng);
     const common::BlockIndex key{trial % 5 - 2, trial % 3, -1};
-    EvidenceGrid layer(p.block_side(), p.channels());
+    EvidenceGrid layer(p.cells_per_side(), p.channels());
     layer.put_block(key, std::vector<float>(layer.block_floats(), 1.0f));
     const auto written = resample_layer(layer, p, p, T);
     const auto touched = touched_blocks(key, p, p, T);

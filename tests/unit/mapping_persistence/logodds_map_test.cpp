@@ -10,10 +10,10 @@
 namespace semap::mapping {
 namespace {
 
-LayeredMapParams logodds_params(int classes = 5) {
-  LayeredMapParams p;
+MapParams logodds_params(int classes = 5) {
+  MapParams p;
   p.method = MapMethod::kLogOdds;
-  p.resolution = 0.1;
+  p.resolution = 0.1f;
   p.num_classes = classes;
   return p;
 }
@@ -110,7 +110,7 @@ TEST(LogOddsMap, CellHitAndCrossedInOneScanCountsAsHit) {
 }
 
 TEST(LogOddsMap, BeamsBeyondMaxRangeOnlyClearSpace) {
-  LayeredMapParams p = logodds_params();
+  MapParams p = logodds_params();
   p.logodds.max_range = 0.5;
   LogOddsMap map(p, 1);
   map.insert(beam({0.05f, 0.05f, 0.05f}, {2.05f, 0.05f, 0.05f}, 1));
@@ -154,7 +154,7 @@ TEST(LogOddsMap, RejectsCloudWithMismatchedLabels) {
   common::LabeledCloud cloud;
   cloud.points = {{1.0f, 0.0f, 0.0f}};
   EXPECT_THROW(map.insert(cloud), std::invalid_argument);
-  LayeredMapParams bki = logodds_params();
+  MapParams bki = logodds_params();
   bki.method = MapMethod::kBki;
   EXPECT_THROW(LogOddsMap(bki, 1), std::invalid_argument);
 }

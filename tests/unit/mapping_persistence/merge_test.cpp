@@ -37,7 +37,7 @@ TEST(Merge, IdentityMergeAddsOccupancyAndLabelLogOdds) {
   std::vector<float> fa(5), fb(5), fm(5);
   for (const common::BlockIndex& key : b.block_keys()) {
     for (int c = 0; c < 64; c += 5) {
-      const common::CellIndex cell = cell_of_local(key, c, a.params().block_side());
+      const common::CellIndex cell = cell_of_local(key, c, a.params().cells_per_side());
       const bool ka = a_before.fused(cell, fa);
       const bool kb = b.fused(cell, fb);
       ASSERT_EQ(a.fused(cell, fm), ka || kb);
@@ -88,7 +88,7 @@ TEST(Merge, NewerCopyOfASourceReplacesTheOlderOne) {
 }
 
 TEST(Merge, ResamplingMovesEvidenceWithTheTransform) {
-  LayeredMapParams p = testing::small_logodds_params();
+  MapParams p = testing::small_logodds_params();
   LayeredMap b(p);
   // A single labelled cell in B's frame.
   const Eigen::Vector3d in_b(0.45, 0.15, 0.05);
@@ -116,10 +116,10 @@ TEST(Merge, ResamplingMovesEvidenceWithTheTransform) {
 }
 
 TEST(Merge, DirichletMapsAddEvidence) {
-  LayeredMapParams p;
+  MapParams p;
   p.method = MapMethod::kBki;
   p.num_classes = 3;
-  p.prior = 0.5;
+  p.prior = 0.5f;
   LayeredMap a(p);
   LayeredMap b(p);
   const common::CellIndex cell(3, -1, 2);
@@ -141,7 +141,7 @@ TEST(Merge, DirichletMapsAddEvidence) {
 
 TEST(Merge, RejectsIncompatibleMaps) {
   LayeredMap a(testing::small_logodds_params());
-  LayeredMapParams other = testing::small_logodds_params();
+  MapParams other = testing::small_logodds_params();
   other.num_classes = 7;
   EXPECT_THROW(merge_into(a, LayeredMap(other), Eigen::Isometry3d::Identity()),
                std::invalid_argument);

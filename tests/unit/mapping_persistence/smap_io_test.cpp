@@ -2,12 +2,15 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include "test_maps.hpp"
 
@@ -16,10 +19,12 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// Bytes before the first block record of a one-layer file: the header (its parameter names
-// read from the file) and the 24-byte layer record.
-std::size_t header_and_layer_size(const std::vector<std::uint8_t>& bytes) {
-  std::size_t at = 8 + 4 + 1 + 1 + 2 + 4 + 8 + 8;  // magic .. prior
+constexpr std::size_t kResolutionAt = 8 + 4 + 1 + 1 + 2 + 4;  // magic .. channel count
+constexpr std::size_t kPriorAt = kResolutionAt + 8;
+
+// Offset of the header's CRC32 (the parameter names read from the file).
+std::size_t header_crc_at(const std::vector<std::uint8_t>& bytes) {
+  std::size_t at = kPriorAt + 8;
   std::uint32_t parameters = 0;
   std::memcpy(&parameters, &bytes[at], 4);
   at += 4;
@@ -28,8 +33,81 @@ std::size_t header_and_layer_size(const std::vector<std::uint8_t>& bytes) {
     std::memcpy(&length, &bytes[at], 2);
     at += 2 + length + 8;
   }
-  at += 4 + 4;                    // layer count, CRC32
-  return at + 4 + 4 + 8 + 4 + 4;  // "LAYR", source, updates, block count, CRC32
+  return at + 4;  // layer count
+}
+
+// Bytes before the first block record of a one-layer file: the header and the 24-byte layer
+// record.
+std::size_t header_and_layer_size(const std::vector<std::uint8_t>& bytes) {
+  return header_crc_at(bytes) + 4 + 4 + 4 + 8 + 4 + 4;  // CRC32, "LAYR", source, updates,
+                                                        // block count, CRC32
+}
+
+// Offset of the name of header parameter `name` (its value follows it).
+std::size_t parameter_at(const std::vector<std::uint8_t>& bytes, std::string_view name) {
+  std::size_t at = kPriorAt + 8 + 4;
+  while (at < header_crc_at(bytes)) {
+    std::uint16_t length = 0;
+    std::memcpy(&length, &bytes[at], 2);
+    if (std::string_view(reinterpret_cast<const char*>(&bytes[at + 2]), length) == name) {
+      return at + 2;
+    }
+    at += 2 + length + 8;
+  }
+  ADD_FAILURE() << "no parameter " << name;
+  return 0;
+}
+
+std::size_t value_at(const std::vector<std::uint8_t>& bytes, std::string_view name) {
+  return parameter_at(bytes, name) + name.size();
+}
+
+// Writes `value` at `at` and the header's CRC32 anew, as a writer of such a file would.
+void put_header_value(std::vector<std::uint8_t>& bytes, std::size_t at, double value) {
+  std::memcpy(&bytes[at], &value, 8);
+  const std::size_t crc_at = header_crc_at(bytes);
+  const auto crc = static_cast<std::uint32_t>(::crc32(0L, bytes.data(), crc_at));
+  std::memcpy(&bytes[crc_at], &crc, 4);
+}
+
+void rename_parameter(std::vector<std::uint8_t>& bytes, std::string_view from,
+                      std::string_view to) {
+  ASSERT_EQ(from.size(), to.size());
+  const std::size_t at = value_at(bytes, from);
+  std::memcpy(&bytes[at - to.size()], to.data(), to.size());
+  double value = 0;
+  std::memcpy(&value, &bytes[at], 8);
+  put_header_value(bytes, at, value);
+}
+
+std::string decode_error(const std::vector<std::uint8_t>& bytes) {
+  try {
+    decode_smap(bytes, "edited.smap");
+  } catch (const SmapError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+// An S-BKI map's layers with every stored setting off its default.
+LayeredMap bki_map() {
+  MapParams p;
+  p.method = MapMethod::kCsm;
+  p.resolution = 0.2f;
+  p.block_depth = 2;
+  p.num_classes = 3;
+  p.sf2 = 0.5f;
+  p.ell = 0.45f;
+  p.prior = 0.02f;
+  p.free_res = 0.7f;
+  p.ds_res = 0.15f;
+  p.max_range = -1.0f;
+  p.unknown_variance = 0.01f;
+  p.logodds.prob_hit = 0.8;
+  p.logodds.max_range = 12.0;
+  LayeredMap map(p);
+  map.layer(3).cell({1, 2, -3})[1] = 2.5f;
+  return map;
 }
 
 class SmapIo : public ::testing::Test {
@@ -57,10 +135,10 @@ TEST_F(SmapIo, RoundTripKeepsEveryLayerAndParameter) {
 }
 
 TEST_F(SmapIo, RoundTripOfDirichletMap) {
-  LayeredMapParams p;
+  MapParams p;
   p.method = MapMethod::kBki;
   p.num_classes = 3;
-  p.prior = 0.01;
+  p.prior = 0.01f;
   LayeredMap map(p);
   map.layer(5).cell({1, -2, 3})[2] = 4.5f;
   map.layer(5).set_updates(9);
@@ -178,24 +256,69 @@ TEST_F(SmapIo, SalvageOfCutSingleLayerKeepsEveryBlockBeforeTheCut) {
   }
 }
 
-// Found by smap_crc_fixed_fuzz: a header whose prior (7.7e66 in the crash input) is a finite
-// double beyond float range was accepted, and semantic_params turned it into inf; the bki.*
-// settings, also floats in MapParams, had the same hole.
-TEST(SmapHeader, ParametersBeyondFloatRangeAreRefused) {
-  LayeredMapParams p = testing::small_logodds_params();
-  p.method = MapMethod::kBki;
-  p.extra["bki.ell"] = 0.3;
-  EXPECT_NO_THROW(validate(p));
-  p.extra["bki.ell"] = 1e300;
-  try {
-    validate(p);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_THAT(e.what(), HasSubstr("bki.ell"));
+TEST(SmapHeader, EveryStoredSettingRoundTrips) {
+  const LayeredMap map = bki_map();
+  const SmapReadResult read = decode_smap(encode_smap(map), "mem");
+  EXPECT_EQ(read.map.params(), map.params());
+  EXPECT_EQ(read.map, map);
+}
+
+// The prior, resolution and S-BKI settings are floats stored as doubles: a finite double
+// beyond float range (smap_crc_fixed_fuzz found a prior of 7.7e66) is refused by name instead
+// of becoming inf.
+TEST(SmapHeader, ParametersBeyondFloatRangeAreRefusedByName) {
+  const auto bytes = encode_smap(bki_map());
+  auto edited = bytes;
+  put_header_value(edited, kPriorAt, 7.7e66);
+  EXPECT_THAT(decode_error(edited), HasSubstr("parameter prior is not finite or beyond float"));
+  edited = bytes;
+  put_header_value(edited, kResolutionAt, -1e300);
+  EXPECT_THAT(decode_error(edited), HasSubstr("parameter resolution"));
+  for (const char* name : {"bki.ell", "bki.sf2", "bki.unknown_variance"}) {
+    edited = bytes;
+    put_header_value(edited, value_at(edited, name), 1e300);
+    EXPECT_THAT(decode_error(edited), HasSubstr(std::string("parameter ") + name)) << name;
   }
-  p.extra["bki.ell"] = 0.3;
-  p.prior = 1e300;
-  EXPECT_THROW(validate(p), std::invalid_argument);
+  // In range but invalid: validate() names the field.
+  edited = bytes;
+  put_header_value(edited, value_at(edited, "bki.ell"), -0.3);
+  EXPECT_THAT(decode_error(edited), HasSubstr("map parameter ell"));
+  edited = bytes;
+  put_header_value(edited, value_at(edited, "logodds.label_spread"), 1e300);
+  EXPECT_THAT(decode_error(edited), HasSubstr("map parameter logodds.label_spread"));
+}
+
+// A name this reader does not know could change what the evidence means: refused, by name.
+TEST(SmapHeader, UnknownOrRepeatedParameterIsRefused) {
+  const auto bytes = encode_smap(bki_map());
+  auto edited = bytes;
+  rename_parameter(edited, "bki.ell", "bki.elk");
+  EXPECT_THAT(decode_error(edited), HasSubstr("unknown parameter 'bki.elk'"));
+  edited = bytes;
+  rename_parameter(edited, "bki.ell", "bki.sf2");
+  EXPECT_THAT(decode_error(edited), HasSubstr("parameter bki.sf2 twice"));
+}
+
+// Files written before every map stored the bki.* settings (log-odds maps, fused maps; the
+// seed corpora hold such files) load with those settings at their defaults.
+TEST(SmapHeader, FilesWithoutBkiSettingsLoadWithDefaults) {
+  const std::filesystem::path corpus =
+      std::filesystem::path(SEMAP_SOURCE_DIR) / "tests/fuzz/corpus/fuzz_smap_reader";
+  const MapParams defaults;
+  for (const char* name : {"bki_two_layers.smap", "logodds_two_beams.smap", "empty.smap"}) {
+    const SmapReadResult read = read_smap(corpus / name);
+    EXPECT_TRUE(read.complete) << name;
+    const MapParams& p = read.map.params();
+    EXPECT_FLOAT_EQ(p.resolution, 0.1f) << name;
+    EXPECT_FLOAT_EQ(p.prior, 0.001f) << name;
+    EXPECT_EQ(p.sf2, defaults.sf2) << name;
+    EXPECT_EQ(p.ell, defaults.ell) << name;
+    EXPECT_EQ(p.unknown_variance, defaults.unknown_variance) << name;
+    EXPECT_EQ(p.logodds, defaults.logodds) << name;
+    EXPECT_EQ(decode_smap(encode_smap(read.map), "again").map, read.map) << name;
+  }
+  EXPECT_EQ(read_smap(corpus / "bki_two_layers.smap").map.params().method, MapMethod::kBki);
+  EXPECT_EQ(read_smap(corpus / "logodds_two_beams.smap").map.params().method, MapMethod::kLogOdds);
 }
 
 TEST_F(SmapIo, RejectsOtherFilesAndVersions) {

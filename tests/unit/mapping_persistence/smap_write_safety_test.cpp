@@ -45,7 +45,7 @@ std::vector<std::string> others(const fs::path& dir, const std::string& keep) {
 LayeredMap big_map(int side, float value) {
   LayeredMap map(testing::small_logodds_params());
   EvidenceGrid& grid = map.layer(1);
-  const int n = map.params().block_side();
+  const int n = map.params().cells_per_side();
   for (int x = 0; x < side; ++x) {
     for (int y = 0; y < side; ++y) {
       for (int z = 0; z < side; ++z) {

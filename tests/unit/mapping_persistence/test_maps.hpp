@@ -7,10 +7,10 @@
 
 namespace semap::mapping::testing {
 
-inline LayeredMapParams small_logodds_params() {
-  LayeredMapParams p;
+inline MapParams small_logodds_params() {
+  MapParams p;
   p.method = MapMethod::kLogOdds;
-  p.resolution = 0.1;
+  p.resolution = 0.1f;
   p.block_depth = 3;
   p.num_classes = 4;
   return p;

@@ -3,7 +3,7 @@
 #include <span>
 #include <vector>
 
-#include "semap/mapping/layered_map_params.hpp"
+#include "semap/mapping/map_params.hpp"
 
 namespace semap::mapping {
 
@@ -20,10 +20,9 @@ struct CellSummary {
 };
 
 // Interprets fused channels (see LayeredMap::fused). S-BKI/S-CSM treat class 0 as free space.
-CellSummary summarize(const LayeredMapParams& params, std::span<const float> fused);
+CellSummary summarize(const MapParams& params, std::span<const float> fused);
 
 // Probability of each of the K classes of a fused cell.
-std::vector<double> class_probabilities(const LayeredMapParams& params,
-                                        std::span<const float> fused);
+std::vector<double> class_probabilities(const MapParams& params, std::span<const float> fused);
 
 }  // namespace semap::mapping

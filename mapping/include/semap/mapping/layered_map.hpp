@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "semap/mapping/evidence_grid.hpp"
-#include "semap/mapping/layered_map_params.hpp"
+#include "semap/mapping/map_params.hpp"
 
 namespace semap::mapping {
 
@@ -22,9 +22,9 @@ using SourceId = std::uint32_t;
 //   S-BKI/S-CSM: alpha = alpha_0 + sum_s (alpha_s - alpha_0), the layers holding increments.
 class LayeredMap {
  public:
-  explicit LayeredMap(const LayeredMapParams& params);
+  explicit LayeredMap(const MapParams& params);
 
-  const LayeredMapParams& params() const { return params_; }
+  const MapParams& params() const { return params_; }
 
   // The layer of `source`, created empty on first use.
   EvidenceGrid& layer(SourceId source);
@@ -44,7 +44,9 @@ class LayeredMap {
   // Blocks over all layers (what a memory budget counts).
   std::size_t resident_blocks() const;
 
-  EvidenceGrid make_grid() const { return EvidenceGrid(params_.block_side(), params_.channels()); }
+  EvidenceGrid make_grid() const {
+    return EvidenceGrid(params_.cells_per_side(), params_.channels());
+  }
 
   bool operator==(const LayeredMap& other) const = default;
 
@@ -52,7 +54,7 @@ class LayeredMap {
   void fuse_into(std::span<const float> layer, std::span<float> out) const;
   void finish_fusion(std::span<float> out) const;
 
-  LayeredMapParams params_;
+  MapParams params_;
   std::map<SourceId, EvidenceGrid> layers_;
 };
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <span>
 
-#include "semap/mapping/layered_map_params.hpp"
+#include "semap/mapping/map_params.hpp"
 
 namespace semap::mapping {
 

@@ -26,7 +26,7 @@ struct LogOddsInsertResult {
 class LogOddsMap {
  public:
   // `params.method` must be kLogOdds; `robot` names the layer this map's own scans go to.
-  LogOddsMap(const LayeredMapParams& params, SourceId robot);
+  LogOddsMap(const MapParams& params, SourceId robot);
   // Continues a map loaded from disk or received from elsewhere.
   LogOddsMap(LayeredMap map, SourceId robot);
 
@@ -41,7 +41,7 @@ class LogOddsMap {
   std::vector<double> class_probabilities(const common::CellIndex& cell) const;
   double occupancy_probability(const common::CellIndex& cell) const;
 
-  const LayeredMapParams& params() const { return map_.params(); }
+  const MapParams& params() const { return map_.params(); }
   SourceId robot() const { return robot_; }
   const LayeredMap& layers() const { return map_; }
   LayeredMap& layers() { return map_; }

@@ -17,8 +17,8 @@ struct MergeReport {
 // the evidence of the source cell its centre falls in under T_from_to = inverse(T_to_from),
 // nearest-neighbour so classes and log-odds are copied, never blended. Identity transforms on
 // equal grids copy blocks unchanged.
-EvidenceGrid resample_layer(const EvidenceGrid& layer, const LayeredMapParams& from_params,
-                            const LayeredMapParams& to_params, const Eigen::Isometry3d& T_to_from);
+EvidenceGrid resample_layer(const EvidenceGrid& layer, const MapParams& from_params,
+                            const MapParams& to_params, const Eigen::Isometry3d& T_to_from);
 
 // Merges map `b` into map `a` given T_ab (B's frame to A's). Per source robot: a source `a`
 // lacks is resampled into A's grid and added; a source both hold is replaced only when B's

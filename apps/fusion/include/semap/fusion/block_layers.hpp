@@ -17,13 +17,13 @@ namespace semap::fusion {
 // Map parameters of an S-BKI/S-CSM map with the shape of `description`; throws
 // std::invalid_argument when the block side is not a power of two or `method` is log-odds
 // (DDS blocks carry Dirichlet evidence only).
-mapping::LayeredMapParams layered_params(const dds_idl::MapDescription& description,
-                                         mapping::MapMethod method, double prior);
+mapping::MapParams map_params_of(const dds_idl::MapDescription& description,
+                                 mapping::MapMethod method, double prior);
 
 // The block's evidence as a layer block; the block must carry evidence of `params`' shape
 // (throws std::invalid_argument otherwise).
 std::vector<float> evidence_block(const dds_idl::BlockSnapshot& block,
-                                  const mapping::LayeredMapParams& params);
+                                  const mapping::MapParams& params);
 
 // The fused block `key` of `map` as a DDS block: evidence alpha - alpha_0 summed over the
 // layers, state, argmax class and its variance as common::CellPosterior reads them

@@ -7,7 +7,7 @@
 #include "semap/common/config.hpp"
 #include "semap/dds_idl/map_description.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
-#include "semap/mapping/layered_map_params.hpp"
+#include "semap/mapping/map_params.hpp"
 
 namespace semap::fusion {
 

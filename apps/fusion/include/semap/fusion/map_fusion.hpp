@@ -70,7 +70,7 @@ class MapFusion : private dds_idl::BlockSource {
   bool read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
 
   MapFusionConfig config_;
-  mapping::LayeredMapParams params_;
+  mapping::MapParams params_;
   std::vector<Robot> robots_;
   mapping::LayeredMap fused_;
   dds_idl::MapPublisher publisher_;
