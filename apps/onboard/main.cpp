@@ -106,8 +106,8 @@ int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_confi
   const double cores = cpu_seconds() / wall_s;
   std::printf("cpu              : %.2f cores over %.1f s\n", cores, wall_s);
   if (report && !report->dir().empty()) {
-    const bool onnx = config.segmenter.kind == onboard::SegmenterConfig::Kind::kOnnx;
-    const auto summary = report->write(pipeline, onnx ? "onnx" : "palette", cores);
+    const bool dnn = config.segmenter.kind == onboard::SegmenterConfig::Kind::kDnn;
+    const auto summary = report->write(pipeline, dnn ? "dnn" : "palette", cores);
     std::printf("report           : %s\n", summary.c_str());
   }
   // Stopped by a signal (systemctl stop, Ctrl-C), the run ended as asked: the map is saved, and

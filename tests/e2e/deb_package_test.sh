@@ -62,7 +62,7 @@ domain=$(((RANDOM % 200) + 20))
     "$onboard" --config config/sim.yaml --duration 20 --domain "$domain" --save "$work/map.smap" \
     >"$work/onboard.log" 2>&1) || { cat "$work/onboard.log"; fail "the installed semap-onboard failed"; }
 sleep 0.5
-grep -q "perception: onnx segmenter" "$work/onboard.log" ||
+grep -q "perception: dnn segmenter" "$work/onboard.log" ||
   { cat "$work/onboard.log"; fail "the installed model did not load"; }
 grep -q "systemd watchdog: pinging every second" "$work/onboard.log" || fail "no watchdog"
 [[ -s "$work/map.smap" ]] || fail "no map saved"

@@ -47,8 +47,9 @@ perception::StereoCalibration load_stereo_calibration(const std::filesystem::pat
 
 // segmenter: what labels the pixels.
 struct SegmenterConfig {
-  enum class Kind { kOnnx, kPalette } kind = Kind::kPalette;
-  std::filesystem::path model_card;  // onnx
+  // kDnn: a network OpenCV's DNN module reads (YAML `kind: dnn`, or `onnx`, its older name).
+  enum class Kind { kDnn, kPalette } kind = Kind::kPalette;
+  std::filesystem::path model_card;  // dnn
   // palette: YAML file; empty = the Cityscapes colours of the simulated world's classes
   std::filesystem::path palette;
   float confidence = 0.9f;  // palette: probability given to the colour's class
