@@ -27,7 +27,9 @@ apt-get install --simulate --no-install-recommends "$deb" >"$work/apt.log" 2>&1 
 
 root="$work/root"
 dpkg-deb -x "$deb" "$root"
-for f in usr/bin/semap-onboard usr/bin/semap-map-listener usr/share/semap/models/semap-seg.onnx \
+for f in usr/bin/semap-onboard usr/bin/semap-map-listener usr/bin/semap-segment \
+  usr/share/semap/models/semap-seg.onnx usr/share/semap/models/enet-cityscapes.net \
+  usr/share/semap/models/enet-cityscapes.yaml usr/share/semap/models/enet-cityscapes.LICENSE \
   usr/share/semap/config/sim.yaml usr/share/semap/imu.dbc etc/semap/semap.yaml \
   usr/lib/systemd/system/semap-onboard.service usr/share/doc/semap/deploy.md; do
   [[ -e "$root/$f" ]] || fail "the package has no /$f"
