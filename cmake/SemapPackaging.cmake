@@ -1,6 +1,7 @@
 # `cmake --install` and the Debian package (scripts/package, CPack DEB). Layout:
 #   /usr/bin/semap-*                          the executables
-#   /usr/share/semap/{config,models}/, imu.dbc the examples, the shipped model, the IMU's DBC
+#   /usr/share/semap/{config,models}/, imu.dbc the examples, the shipped models (cards, networks,
+#                                             licences), the IMU's DBC
 #   /usr/share/doc/semap/                     README and docs
 #   /etc/semap/semap.yaml, cyclonedds.xml     the robot's configuration (conffiles)
 #   /lib/systemd/system/semap-onboard.service the service (docs/deploy.md)
@@ -12,7 +13,7 @@ set(SEMAP_DATA_DIR ${CMAKE_INSTALL_DATADIR}/semap)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${SEMAP_DATA_DIR}/config
         PATTERN "*.service" EXCLUDE)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/models/ DESTINATION ${SEMAP_DATA_DIR}/models
-        FILES_MATCHING PATTERN "*.onnx" PATTERN "*.yaml")
+        FILES_MATCHING PATTERN "*.onnx" PATTERN "*.net" PATTERN "*.yaml" PATTERN "*.LICENSE")
 install(FILES ${PROJECT_SOURCE_DIR}/firmware_bridge/imu.dbc DESTINATION ${SEMAP_DATA_DIR})
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})

@@ -179,7 +179,7 @@ def write_card(args, info, names, mean, std, width, height, n_train, n_val, seco
     card = os.path.splitext(args.out)[0] + ".yaml"
     lines = [
         "# Model card of semap's shipped segmentation network (written by scripts/train-segmenter;",
-        "# do not edit by hand: retrain). OnnxSegmenter reads the keys; the comments record how",
+        "# do not edit by hand: retrain). DnnSegmenter reads the keys; the comments record how",
         "# the network was made and how well it does.",
         "#",
         f"# Architecture: {len(names)}-class fully convolutional network, two stride-2 stages and",

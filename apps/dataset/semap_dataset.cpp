@@ -72,7 +72,7 @@ onboard::OnboardConfig pipeline_config(const Options& o, int map_classes) {
   if (o.no_labels) {
     c.segmenter.kind = onboard::SegmenterConfig::Kind::kGeometry;
   } else {
-    c.segmenter.kind = onboard::SegmenterConfig::Kind::kOnnx;
+    c.segmenter.kind = onboard::SegmenterConfig::Kind::kDnn;
     c.segmenter.model_card = o.segmenter_card;
   }
   return c;

@@ -5,8 +5,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "semap/estimation/oxts_reader.hpp"
+#include "semap/perception/dnn_segmenter.hpp"
 #include "semap/perception/model_card.hpp"
-#include "semap/perception/onnx_segmenter.hpp"
 
 namespace semap::apps {
 
@@ -36,7 +36,7 @@ class ModelLabelSource : public ScanLabelSource {
   std::string describe() const override { return segmenter_.describe(); }
 
  private:
-  perception::OnnxSegmenter segmenter_;
+  perception::DnnSegmenter segmenter_;
   fs::path image_dir_;
 };
 

@@ -87,7 +87,7 @@ int render_world(const Settings& s, int seed, const std::filesystem::path& folde
     world_from_body.translation() = truth.position.cast<float>();
     const auto frame = camera.render(world, world_from_body * body_from_optical,
                                      static_cast<std::uint64_t>(index));
-    // The network sees what OnnxSegmenter gives it: the image resized bilinearly.
+    // The network sees what DnnSegmenter gives it: the image resized bilinearly.
     cv::Mat bgr;
     cv::Mat rgb;
     cv::Mat labels;

@@ -28,7 +28,7 @@
 #include "semap/onboard/segmenter_factory.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
 #include "semap/perception/depth_cloud.hpp"
-#include "semap/perception/onnx_segmenter.hpp"
+#include "semap/perception/dnn_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 #include "semap/perception/sim_classes.hpp"
 
@@ -92,7 +92,7 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
       "decode MJPEG -> BGR (q90, " + std::to_string(mjpeg.data.size() / 1024) + " KiB)";
   row(jpeg_what, bench::time_ms(n, [&](int) { image = semap::drivers::to_mat(mjpeg, jpeg); }));
 
-  perception::OnnxSegmenter onnx(perception::load_model_card(model.card));
+  perception::DnnSegmenter onnx(perception::load_model_card(model.card));
   const cv::Mat bgr = semap::drivers::to_mat(scene.yuyv, jpeg);
   perception::Segmentation seg;
   char what[160];
@@ -169,7 +169,7 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   common::SpscRing<common::LabeledCloud> cloud_ring(config.depth.ring, OverflowPolicy::kDropOldest);
   onboard::SharedPoseHistory poses(config.estimator.history);
   onboard::SegmenterConfig seg;
-  seg.kind = onboard::SegmenterConfig::Kind::kOnnx;
+  seg.kind = onboard::SegmenterConfig::Kind::kDnn;
   seg.model_card = model.card;
   onboard::PerceptionStage perception(config.camera, config.depth,
                                       onboard::make_segmenter(seg, config.map.params.num_classes),

@@ -150,11 +150,12 @@ void read_depth(const ConfigSection& s, const CameraConfig& camera, DepthConfig&
 }
 
 void read_segmenter(const ConfigSection& s, SegmenterConfig& seg) {
-  const std::string kind = s.get_choice("kind", "palette", {"onnx", "palette", "geometry"});
-  seg.kind = kind == "onnx"       ? SegmenterConfig::Kind::kOnnx
+  // `onnx` was the only network format once; configs that say so keep working.
+  const std::string kind = s.get_choice("kind", "palette", {"dnn", "onnx", "palette", "geometry"});
+  seg.kind = kind == "palette"    ? SegmenterConfig::Kind::kPalette
              : kind == "geometry" ? SegmenterConfig::Kind::kGeometry
-                                  : SegmenterConfig::Kind::kPalette;
-  if (seg.kind == SegmenterConfig::Kind::kOnnx) {
+                                  : SegmenterConfig::Kind::kDnn;
+  if (seg.kind == SegmenterConfig::Kind::kDnn) {
     seg.model_card = std::filesystem::absolute(s.get<std::string>("model_card"));
   } else if (seg.kind == SegmenterConfig::Kind::kPalette) {
     if (s.has("palette")) seg.palette = std::filesystem::absolute(s.get<std::string>("palette"));
@@ -228,7 +229,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
     check_segmenter_files(c.segmenter, c.map.params.num_classes);
   } catch (const std::exception& e) {
     const auto segmenter = root.section_or_empty("segmenter");
-    segmenter.reject(c.segmenter.kind == SegmenterConfig::Kind::kOnnx ? "model_card" : "palette",
+    segmenter.reject(c.segmenter.kind == SegmenterConfig::Kind::kDnn ? "model_card" : "palette",
                      e.what());
   }
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();

@@ -3,9 +3,9 @@
 #include <string>
 
 #include "semap/common/config.hpp"
+#include "semap/perception/dnn_segmenter.hpp"
 #include "semap/perception/geometry_segmenter.hpp"
 #include "semap/perception/model_card.hpp"
-#include "semap/perception/onnx_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 #include "semap/perception/sim_classes.hpp"
 
@@ -27,8 +27,8 @@ perception::ModelCard load_card_for_map(const std::filesystem::path& file, int m
 
 std::unique_ptr<perception::Segmenter> make_segmenter(const SegmenterConfig& config,
                                                       int map_classes) {
-  if (config.kind == SegmenterConfig::Kind::kOnnx) {
-    return std::make_unique<perception::OnnxSegmenter>(
+  if (config.kind == SegmenterConfig::Kind::kDnn) {
+    return std::make_unique<perception::DnnSegmenter>(
         load_card_for_map(config.model_card, map_classes));
   }
   if (config.kind == SegmenterConfig::Kind::kGeometry) {
@@ -43,10 +43,10 @@ std::unique_ptr<perception::Segmenter> make_segmenter(const SegmenterConfig& con
 }
 
 void check_segmenter_files(const SegmenterConfig& config, int map_classes) {
-  if (config.kind == SegmenterConfig::Kind::kOnnx) {
+  if (config.kind == SegmenterConfig::Kind::kDnn) {
     load_card_for_map(config.model_card, map_classes);
   } else {
-    make_segmenter(config, map_classes);  // a palette is a small table
+    make_segmenter(config, map_classes);  // a palette is a small table; geometry has none
   }
 }
 

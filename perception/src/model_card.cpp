@@ -1,5 +1,9 @@
 #include "semap/perception/model_card.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cctype>
+
 #include "class_list_reader.hpp"
 #include "semap/common/config.hpp"
 #include "semap/perception/segmentation.hpp"
@@ -9,6 +13,78 @@ namespace semap::perception {
 namespace {
 
 using common::ConfigSection;
+
+enum class ConfigNeed { kNone, kOptional, kRequired };
+
+// What each format reads, in ModelFormat's order: the model file extensions that imply it when the
+// card has no `format:`, and whether it takes a second file (and that file's usual extension, for
+// messages).
+struct FormatRule {
+  ModelFormat format;
+  std::string_view name;
+  std::array<std::string_view, 2> extensions;  // "" = none
+  ConfigNeed config;
+  std::string_view config_file;  // the config file's usual extension
+};
+
+constexpr std::array<FormatRule, 5> kFormats{{
+    {ModelFormat::kOnnx, "onnx", {".onnx", ""}, ConfigNeed::kNone, ""},
+    {ModelFormat::kTorch, "torch", {".t7", ".net"}, ConfigNeed::kNone, ""},
+    {ModelFormat::kCaffe, "caffe", {".caffemodel", ""}, ConfigNeed::kRequired, ".prototxt"},
+    {ModelFormat::kTensorflow, "tensorflow", {".pb", ""}, ConfigNeed::kOptional, ".pbtxt"},
+    {ModelFormat::kDarknet, "darknet", {".weights", ""}, ConfigNeed::kRequired, ".cfg"},
+}};
+
+constexpr bool formats_in_enum_order() {
+  for (std::size_t i = 0; i < kFormats.size(); ++i) {
+    if (static_cast<std::size_t>(kFormats[i].format) != i) return false;
+  }
+  return true;
+}
+static_assert(formats_in_enum_order(), "format_name() indexes kFormats by ModelFormat");
+
+std::filesystem::path next_to_card(const std::filesystem::path& card,
+                                   const std::filesystem::path& file) {
+  return file.is_absolute() ? file : card.parent_path() / file;
+}
+
+const FormatRule& read_format(const ConfigSection& root, const std::filesystem::path& model) {
+  std::vector<std::string> names;
+  for (const FormatRule& rule : kFormats) names.emplace_back(rule.name);
+  if (root.has("format")) {
+    const std::string name = root.get_choice("format", "", names);
+    return *std::find_if(kFormats.begin(), kFormats.end(),
+                         [&](const FormatRule& rule) { return rule.name == name; });
+  }
+  std::string extension = model.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const FormatRule& rule : kFormats) {
+    if (!extension.empty() && std::find(rule.extensions.begin(), rule.extensions.end(),
+                                        extension) != rule.extensions.end()) {
+      return rule;
+    }
+  }
+  root.reject("model", "extension '" + extension +
+                           "' names no format (.onnx, .t7, .net, .caffemodel, .pb, .weights); "
+                           "say which with format: onnx|torch|caffe|tensorflow|darknet");
+}
+
+void read_config_file(const ConfigSection& root, const FormatRule& rule, ModelCard& card) {
+  const std::string format = "format " + std::string(rule.name);
+  if (!root.has("config")) {
+    if (rule.config == ConfigNeed::kRequired) {
+      root.reject("config", format + " needs its network definition (" +
+                                std::string(rule.config_file) + "): required but missing");
+    }
+    return;
+  }
+  if (rule.config == ConfigNeed::kNone) root.reject("config", format + " takes no config file");
+  card.config_file = next_to_card(card.card_file, root.get<std::string>("config"));
+  if (!std::filesystem::is_regular_file(card.config_file)) {
+    root.reject("config", "config file '" + card.config_file.string() + "' not found");
+  }
+}
 
 int int_in_range(const ConfigSection& s, const std::string& key, int lo, int hi) {
   const int v = s.get<int>(key);
@@ -77,16 +153,22 @@ void read_map(const ConfigSection& s, ModelCard& card) {
 
 }  // namespace
 
+std::string_view format_name(ModelFormat format) {
+  return kFormats[static_cast<std::size_t>(format)].name;
+}
+
 ModelCard load_model_card(const std::filesystem::path& yaml) {
   const ConfigSection root = ConfigSection::load_file(yaml);
   ModelCard card;
   card.card_file = yaml;
 
-  const std::filesystem::path model = root.get<std::string>("model");
-  card.model_file = model.is_absolute() ? model : yaml.parent_path() / model;
+  card.model_file = next_to_card(yaml, root.get<std::string>("model"));
   if (!std::filesystem::is_regular_file(card.model_file)) {
     root.reject("model", "model file '" + card.model_file.string() + "' not found");
   }
+  const FormatRule& format = read_format(root, card.model_file);
+  card.format = format.format;
+  read_config_file(root, format, card);
   read_input(root.section("input"), card);
   card.output = required_choice(root, "output", {"logits", "probabilities"}) == "logits"
                     ? ModelOutput::kLogits

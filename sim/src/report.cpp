@@ -147,8 +147,10 @@ void SimReport::summary(std::vector<std::string>& lines) const {
 
 std::filesystem::path SimReport::write(onboard::Pipeline& pipeline) const {
   RunFigures figures;
-  const bool onnx = pipeline.config().segmenter.kind == onboard::SegmenterConfig::Kind::kOnnx;
-  figures.segmenter = onnx ? "onnx" : "palette";
+  const auto kind = pipeline.config().segmenter.kind;
+  figures.segmenter = kind == onboard::SegmenterConfig::Kind::kDnn        ? "dnn"
+                      : kind == onboard::SegmenterConfig::Kind::kGeometry ? "geometry"
+                                                                          : "palette";
   if (accuracy_.any()) figures.pose_rmse_m = accuracy_.rmse();
   figures.frames_captured = rig_.camera().rendered();
   figures.frames_mapped = pipeline.mapping().scans;

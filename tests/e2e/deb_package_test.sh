@@ -27,7 +27,9 @@ apt-get install --simulate --no-install-recommends "$deb" >"$work/apt.log" 2>&1 
 
 root="$work/root"
 dpkg-deb -x "$deb" "$root"
-for f in usr/bin/semap-onboard usr/bin/semap-map-listener usr/share/semap/models/semap-seg.onnx \
+for f in usr/bin/semap-onboard usr/bin/semap-map-listener usr/bin/semap-segment \
+  usr/share/semap/models/semap-seg.onnx usr/share/semap/models/enet-cityscapes.net \
+  usr/share/semap/models/enet-cityscapes.yaml usr/share/semap/models/enet-cityscapes.LICENSE \
   usr/share/semap/config/sim.yaml usr/share/semap/imu.dbc etc/semap/semap.yaml \
   usr/lib/systemd/system/semap-onboard.service usr/share/doc/semap/deploy.md; do
   [[ -e "$root/$f" ]] || fail "the package has no /$f"
@@ -62,7 +64,7 @@ domain=$(((RANDOM % 200) + 20))
     "$onboard" --config config/sim.yaml --duration 20 --domain "$domain" --save "$work/map.smap" \
     >"$work/onboard.log" 2>&1) || { cat "$work/onboard.log"; fail "the installed semap-onboard failed"; }
 sleep 0.5
-grep -q "perception: onnx segmenter" "$work/onboard.log" ||
+grep -q "perception: dnn segmenter" "$work/onboard.log" ||
   { cat "$work/onboard.log"; fail "the installed model did not load"; }
 grep -q "systemd watchdog: pinging every second" "$work/onboard.log" || fail "no watchdog"
 [[ -s "$work/map.smap" ]] || fail "no map saved"

@@ -37,12 +37,12 @@ grep -q "namespace: $ns" "$work/sim.yaml" && grep -q "save_path: $work/map.smap"
 # Thresholds per segmenter, measured on this 2-core machine (30 s runs, with margin; the
 # rendered frames are deterministic, the poses nearly so):
 # - palette on class-painted frames (a perfect segmenter): segmentation mIoU 1.000, map 0.769;
-# - onnx (models/semap-seg.onnx on rendered frames): segmentation mIoU 0.832, map mIoU 0.701;
+# - dnn (models/semap-seg.onnx on rendered frames): segmentation mIoU 0.832, map mIoU 0.701;
 #   a retrained model needs these looked at again.
 # map_miou scores every occupied cell against the world's class within its half-diagonal, so
 # cells that the S-BKI kernel, depth noise and pose error put next to a surface count against it.
 min_seg_palette=0.99 min_map_palette=0.65
-min_seg_onnx=0.75 min_map_onnx=0.6
+min_seg_dnn=0.75 min_map_dnn=0.6
 
 listen() { # listen DELAY NAME [flags]: a listener joining DELAY s after the robot started
   local delay="$1" name="$2"
@@ -123,7 +123,7 @@ done
 segmenter=$(sed -n 's/.*"segmenter": "\([a-z]*\)".*/\1/p' "$report/summary.json")
 case "$segmenter" in
   palette) min_seg=$min_seg_palette min_map=$min_map_palette ;;
-  onnx) min_seg=$min_seg_onnx min_map=$min_map_onnx ;;
+  dnn) min_seg=$min_seg_dnn min_map=$min_map_dnn ;;
   *) fail "segmenter '$segmenter'" ;;
 esac
 rmse=$(json pose_rmse_m)

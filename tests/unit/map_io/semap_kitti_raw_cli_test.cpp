@@ -146,7 +146,7 @@ TEST(SemapKittiRawSegmenter, ModelCardLabelsTheCameraImages) {
   const CliResult r = run("raw --drive " + drive.drive_dir.string() + " --segmenter " +
                           card.string() + " --out " + (root / "out").string());
   ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_TRUE(has(r.out, "onnx segmenter")) << r.out;
+  EXPECT_TRUE(has(r.out, "dnn segmenter: ")) << r.out;
   EXPECT_EQ(figure(r.out, "soft_labelled "), figure(r.out, "mapped ")) << r.out;
   const auto cells = occupied_cells(mapping::read_smap(root / "out/map.smap").map);
   const Eigen::Vector3d under = drive.simulation.truth.back().state.position;

@@ -58,7 +58,7 @@ TEST(OnboardConfig, SimulatedRigExample) {
   // Aligned depth takes the colour camera's size unless the file says otherwise.
   EXPECT_EQ(c.depth.driver.width, 640u);
   EXPECT_EQ(c.depth.driver.format, common::PixelFormat::kZ16);
-  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
+  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kDnn);
   EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
   EXPECT_EQ(sim_rig.camera_image, sim::SimCameraImage::kRgb);
   EXPECT_EQ(sim_rig.trajectory.scenario, sim::Scenario::kFigureEight);
@@ -92,7 +92,7 @@ TEST(OnboardConfig, RgbdRobotExample) {
   EXPECT_FLOAT_EQ(c.depth.depth_scale, 0.001f);
   EXPECT_EQ(c.depth.points.stride, 2);
   EXPECT_FLOAT_EQ(c.depth.points.min_confidence, 0.5f);
-  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kOnnx);
+  EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kDnn);
   EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml");
   // The shipped model's classes are the map's.
   EXPECT_EQ(make_segmenter(c.segmenter, c.map.params.num_classes)->num_classes(),
@@ -253,15 +253,28 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
   }
 }
 
+// `dnn` names any network OpenCV reads; `onnx`, the only format once, stays a name for it.
+TEST(OnboardConfig, DnnAndOnnxKindsAreTheSameSegmenter) {
+  for (const std::string kind : {"dnn", "onnx"}) {
+    const auto path = edited_sim("kind: onnx ", "kind: " + kind + " ");
+    const auto c = load(path);
+    std::filesystem::remove(path);
+    EXPECT_EQ(c.segmenter.kind, SegmenterConfig::Kind::kDnn) << kind;
+    EXPECT_EQ(c.segmenter.model_card.filename(), "semap-seg.yaml") << kind;
+  }
+  EXPECT_NE(error_of(edited_sim("kind: onnx ", "kind: torch ")).find("not one of dnn|onnx|palette"),
+            std::string::npos);
+}
+
 TEST(OnboardConfig, SegmenterMustFitTheMap) {
   SegmenterConfig palette;
   // The default palette feeds the simulated world's map classes 1..7: a 4-class map cannot take it.
   EXPECT_THROW(make_segmenter(palette, 4), std::invalid_argument);
-  SegmenterConfig onnx;
-  onnx.kind = SegmenterConfig::Kind::kOnnx;
-  onnx.model_card = "/nonexistent/card.yaml";
+  SegmenterConfig dnn;
+  dnn.kind = SegmenterConfig::Kind::kDnn;
+  dnn.model_card = "/nonexistent/card.yaml";
   try {
-    make_segmenter(onnx, 4);
+    make_segmenter(dnn, 4);
     FAIL() << "no error";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/card.yaml"), std::string::npos) << e.what();

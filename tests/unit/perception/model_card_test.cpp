@@ -154,5 +154,93 @@ TEST(ModelCard, BadValues) {
   expect_names(card_error(dir, card_yaml(f)), card + ":14", "map.num_classes", "out of range");
 }
 
+// Loads a card for a model file `model` (written, empty) with `extra` lines (format:, config:).
+ModelCard card_for(const TempDir& dir, const std::string& model, const std::string& extra) {
+  write_text(dir / model, "");
+  CardFields f;
+  f.model = model;
+  f.extra = extra;
+  return load_model_card(write_text(dir / "card.yaml", card_yaml(f)));
+}
+
+TEST(ModelCard, EachModelExtensionPicksItsFormat) {
+  TempDir dir;
+  write_text(dir / "net.prototxt", "");
+  write_text(dir / "net.cfg", "");
+  write_text(dir / "graph.pbtxt", "");
+  struct Case {
+    std::string model, extra;
+    ModelFormat format;
+    std::string config;  // "" = none
+  };
+  const std::vector<Case> cases{
+      {"net.onnx", "", ModelFormat::kOnnx, ""},
+      {"enet.t7", "", ModelFormat::kTorch, ""},
+      {"enet-model.net", "", ModelFormat::kTorch, ""},
+      {"ENET.T7", "", ModelFormat::kTorch, ""},
+      {"net.caffemodel", "config: net.prototxt\n", ModelFormat::kCaffe, "net.prototxt"},
+      {"frozen.pb", "", ModelFormat::kTensorflow, ""},
+      {"frozen.pb", "config: graph.pbtxt\n", ModelFormat::kTensorflow, "graph.pbtxt"},
+      {"yolo.weights", "config: net.cfg\n", ModelFormat::kDarknet, "net.cfg"},
+  };
+  for (const Case& c : cases) {
+    const ModelCard card = card_for(dir, c.model, c.extra);
+    EXPECT_EQ(card.format, c.format) << c.model;
+    EXPECT_EQ(card.model_file, dir / c.model);
+    EXPECT_EQ(card.config_file, c.config.empty() ? std::filesystem::path() : dir / c.config)
+        << c.model;
+  }
+  EXPECT_EQ(format_name(ModelFormat::kTensorflow), "tensorflow");
+}
+
+TEST(ModelCard, FormatKeyOverridesTheExtension) {
+  TempDir dir;
+  EXPECT_EQ(card_for(dir, "enet.bin", "format: torch\n").format, ModelFormat::kTorch);
+  EXPECT_EQ(card_for(dir, "net.t7", "format: onnx\n").format, ModelFormat::kOnnx);
+}
+
+TEST(ModelCard, UnknownExtensionWithoutFormatNamesCardLineAndKey) {
+  TempDir dir;
+  const std::string card = (dir / "card.yaml").string();
+  CardFields f;
+  f.model = "net.bin";
+  write_text(dir / "net.bin", "");
+  expect_names(card_error(dir, card_yaml(f)), card + ":1", "model",
+               "extension '.bin' names no format");
+  f.extra = "format: keras\n";
+  expect_names(card_error(dir, card_yaml(f)), card + ":17", "format",
+               "'keras' is not one of onnx|torch|caffe|tensorflow|darknet");
+}
+
+TEST(ModelCard, CaffeAndDarknetWithoutConfigNameCardAndKey) {
+  TempDir dir;
+  const std::string card = (dir / "card.yaml").string();
+  CardFields f;
+  f.model = "net.caffemodel";
+  write_text(dir / f.model, "");
+  expect_names(card_error(dir, card_yaml(f)), card + ":1", "config",
+               "format caffe needs its network definition (.prototxt): required but missing");
+  f.model = "yolo.weights";
+  write_text(dir / f.model, "");
+  expect_names(card_error(dir, card_yaml(f)), card + ":1", "config",
+               "format darknet needs its network definition (.cfg): required but missing");
+}
+
+TEST(ModelCard, ConfigFileMustExistAndSuitTheFormat) {
+  TempDir dir;
+  const std::string card = (dir / "card.yaml").string();
+  CardFields f;
+  f.model = "net.caffemodel";
+  f.extra = "config: missing.prototxt\n";
+  write_text(dir / f.model, "");
+  expect_names(card_error(dir, card_yaml(f)), card + ":17", "config",
+               (dir / "missing.prototxt").string() + "' not found");
+  write_text(dir / "net.prototxt", "");
+  f.model = "net.onnx";
+  f.extra = "config: net.prototxt\n";
+  expect_names(card_error(dir, card_yaml(f)), card + ":17", "config",
+               "format onnx takes no config file");
+}
+
 }  // namespace
 }  // namespace semap::perception

@@ -9,8 +9,9 @@
 namespace semap::perception::testing {
 
 // A model card for a three-class network "net.onnx"; its lines are numbered in the comments
-// so tests can check the line an error names.
+// so tests can check the line an error names. `extra` lines (format:, config:) come last.
 struct CardFields {
+  std::string model = "net.onnx";
   int width = 4;
   int height = 2;
   std::string channel_order = "rgb";
@@ -22,11 +23,12 @@ struct CardFields {
   int num_classes = 4;
   std::string unmapped = "drop";
   std::string from_model = "{a: 1, b: 2, c: 3}";
+  std::string extra;
 };
 
 inline std::string card_yaml(const CardFields& f) {
   // clang-format off
-  return "model: net.onnx\n"                                            // 1
+  return "model: " + f.model + "\n" +                                   // 1
          "input:\n"                                                     // 2
          "  width: " + std::to_string(f.width) + "\n" +                 // 3
          "  height: " + std::to_string(f.height) + "\n" +               // 4
@@ -41,7 +43,8 @@ inline std::string card_yaml(const CardFields& f) {
          "map:\n"                                                       // 13
          "  num_classes: " + std::to_string(f.num_classes) + "\n" +    // 14
          "  unmapped: " + f.unmapped + "\n" +                           // 15
-         "  from_model: " + f.from_model + "\n";                        // 16
+         "  from_model: " + f.from_model + "\n" +                       // 16
+         f.extra;                                                       // 17...
   // clang-format on
 }
 

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <numbers>
 
+#include "semap/perception/dnn_segmenter.hpp"
 #include "semap/perception/model_card.hpp"
-#include "semap/perception/onnx_segmenter.hpp"
 #include "semap/perception/sim_classes.hpp"
 #include "semap/sim/camera.hpp"
 #include "semap/sim/world.hpp"
@@ -32,7 +32,7 @@ std::vector<Eigen::Vector3d> loop_path() {
 TEST(ShippedModel, LoadsAndLabelsTheDemoWorld) {
   const ModelCard card = load_model_card(kCard);
   EXPECT_EQ(card.num_map_classes, kSimMapClasses);
-  OnnxSegmenter segmenter(card);
+  DnnSegmenter segmenter(card);
   const auto path = loop_path();
   sim::SimWorldOptions options;
   options.seed = 7;

@@ -47,9 +47,10 @@ perception::StereoCalibration load_stereo_calibration(const std::filesystem::pat
 
 // segmenter: what labels the pixels.
 struct SegmenterConfig {
+  // kDnn: a network OpenCV's DNN module reads (YAML `kind: dnn`, or `onnx`, its older name).
   // kGeometry: no labels, every depth pixel is map class 1 (geometry only).
-  enum class Kind { kOnnx, kPalette, kGeometry } kind = Kind::kPalette;
-  std::filesystem::path model_card;  // onnx
+  enum class Kind { kDnn, kPalette, kGeometry } kind = Kind::kPalette;
+  std::filesystem::path model_card;  // dnn
   // palette: YAML file; empty = the Cityscapes colours of the simulated world's classes
   std::filesystem::path palette;
   float confidence = 0.9f;  // palette: probability given to the colour's class

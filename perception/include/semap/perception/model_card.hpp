@@ -5,12 +5,18 @@
 #include <filesystem>
 #include <opencv2/core/matx.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace semap::perception {
 
 enum class ChannelOrder { kRgb, kBgr };
 enum class ModelOutput { kLogits, kProbabilities };
+// The network file formats OpenCV 4.6's DNN module reads.
+enum class ModelFormat { kOnnx, kTorch, kCaffe, kTensorflow, kDarknet };
+
+// "onnx", "torch", "caffe", "tensorflow", "darknet": the card's `format:` values.
+std::string_view format_name(ModelFormat format);
 
 // One output channel of a segmentation model.
 struct ModelClass {
@@ -24,7 +30,11 @@ struct ModelClass {
 struct ModelCard {
   std::filesystem::path card_file;   // for error messages
   std::filesystem::path model_file;  // resolved against the card's folder
-  int input_width = 0;               // the network runs at this size
+  ModelFormat format = ModelFormat::kOnnx;
+  // The second file the format reads (Caffe .prototxt, TensorFlow .pbtxt, Darknet .cfg),
+  // resolved against the card's folder; empty when there is none.
+  std::filesystem::path config_file;
+  int input_width = 0;  // the network runs at this size
   int input_height = 0;
   ChannelOrder channel_order = ChannelOrder::kRgb;
   // Per channel, in the model's channel order, on the 0..1 pixel scale:
@@ -39,7 +49,9 @@ struct ModelCard {
 
 // Reads a model card (shape documented in config/model-card-example.yaml). Every problem
 // throws common::ConfigError naming the card file, line and key: a missing or unknown key,
-// counts that do not agree, a map class outside 1..K-1, a model file that does not exist.
+// counts that do not agree, a map class outside 1..K-1, a model or config file that does not
+// exist, a model file whose extension names no format when `format:` is absent, a format
+// without the config file it needs (Caffe, Darknet) or with one it does not take.
 ModelCard load_model_card(const std::filesystem::path& yaml);
 
 }  // namespace semap::perception

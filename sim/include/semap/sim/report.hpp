@@ -52,7 +52,7 @@ class LiveAccuracy {
 
 // The figures of the run the report does not measure itself.
 struct RunFigures {
-  std::string segmenter;  // "onnx" or "palette"
+  std::string segmenter;  // "dnn", "palette" or "geometry"
   std::optional<double> pose_rmse_m;
   std::uint64_t frames_captured = 0;  // rendered by the rig's camera
   std::uint64_t frames_mapped = 0;    // clouds inserted into the map

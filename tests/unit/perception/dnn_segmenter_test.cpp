@@ -1,4 +1,4 @@
-#include "semap/perception/onnx_segmenter.hpp"
+#include "semap/perception/dnn_segmenter.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,10 +24,10 @@ using testing::write_text;
 const std::vector<float> kWeights = {0.5f, -1.0f, 2.0f, 1.0f, 0.3f, -0.7f, -0.2f, 0.8f, 0.1f};
 const std::vector<float> kBias = {0.1f, -0.2f, 0.3f};
 
-std::unique_ptr<OnnxSegmenter> make_segmenter(const TempDir& dir, const CardFields& f,
-                                              const std::string& model) {
+std::unique_ptr<DnnSegmenter> make_segmenter(const TempDir& dir, const CardFields& f,
+                                             const std::string& model) {
   test::write_bytes(dir / "net.onnx", model);
-  return std::make_unique<OnnxSegmenter>(
+  return std::make_unique<DnnSegmenter>(
       load_model_card(write_text(dir / "card.yaml", card_yaml(f))));
 }
 
@@ -62,7 +62,7 @@ cv::Mat uniform_image(const cv::Vec3b& bgr, int width = 8, int height = 6) {
 
 const cv::Vec3b kPixel(10, 100, 200);  // B, G, R
 
-TEST(OnnxSegmenter, SoftmaxMatchesHandComputation) {
+TEST(DnnSegmenter, SoftmaxMatchesHandComputation) {
   TempDir dir;
   CardFields f;  // a -> 1, b -> 2, c -> 3, K = 4
   f.mean = "[0.1, 0.2, 0.3]";
@@ -95,7 +95,7 @@ TEST(OnnxSegmenter, SoftmaxMatchesHandComputation) {
   }
 }
 
-TEST(OnnxSegmenter, BgrCardTakesChannelsInImageOrder) {
+TEST(DnnSegmenter, BgrCardTakesChannelsInImageOrder) {
   TempDir dir;
   CardFields f;
   f.channel_order = "bgr";
@@ -111,7 +111,7 @@ TEST(OnnxSegmenter, BgrCardTakesChannelsInImageOrder) {
   }
 }
 
-TEST(OnnxSegmenter, SeveralModelClassesFeedOneMapClass) {
+TEST(DnnSegmenter, SeveralModelClassesFeedOneMapClass) {
   TempDir dir;
   CardFields f;
   f.num_classes = 3;
@@ -123,7 +123,7 @@ TEST(OnnxSegmenter, SeveralModelClassesFeedOneMapClass) {
   EXPECT_NEAR(probability(s, 1, 1, 2), p[0] + p[2], 1e-5);
 }
 
-TEST(OnnxSegmenter, UnmappedClassesFeedTheConfiguredClass) {
+TEST(DnnSegmenter, UnmappedClassesFeedTheConfiguredClass) {
   TempDir dir;
   CardFields f;
   f.num_classes = 3;
@@ -143,7 +143,7 @@ Segmentation constant_output(const TempDir& dir, CardFields f, const std::vector
       ->segment(uniform_image(kPixel));
 }
 
-TEST(OnnxSegmenter, DroppedMassAboveBestClassGivesNoLabel) {
+TEST(DnnSegmenter, DroppedMassAboveBestClassGivesNoLabel) {
   TempDir dir;
   CardFields f;
   f.output = "probabilities";
@@ -162,7 +162,7 @@ TEST(OnnxSegmenter, DroppedMassAboveBestClassGivesNoLabel) {
   EXPECT_NEAR(s.confidence.at<float>(1, 1), 0.6f, 1e-6);
 }
 
-TEST(OnnxSegmenter, LogitsAndProbabilitiesCards) {
+TEST(DnnSegmenter, LogitsAndProbabilitiesCards) {
   TempDir dir;
   CardFields f;
   f.output = "probabilities";
@@ -182,7 +182,7 @@ TEST(OnnxSegmenter, LogitsAndProbabilitiesCards) {
   EXPECT_NEAR(probability(s, 0, 0, 3), std::exp(0.5) / sum, 1e-4);
 }
 
-TEST(OnnxSegmenter, InfersAtReducedSizeThenResizesBilinearly) {
+TEST(DnnSegmenter, InfersAtReducedSizeThenResizesBilinearly) {
   TempDir dir;
   CardFields f;
   f.width = 2;
@@ -208,7 +208,7 @@ TEST(OnnxSegmenter, InfersAtReducedSizeThenResizesBilinearly) {
   }
 }
 
-TEST(OnnxSegmenter, DeeperNetworkAtQuarterResolution) {
+TEST(DnnSegmenter, DeeperNetworkAtQuarterResolution) {
   TempDir dir;
   CardFields f;
   f.width = 96;
@@ -230,20 +230,99 @@ TEST(OnnxSegmenter, DeeperNetworkAtQuarterResolution) {
   }
 }
 
-TEST(OnnxSegmenter, MalformedOrMissingModelNamesTheFile) {
+TEST(DnnSegmenter, MalformedOrMissingModelNamesTheFile) {
   TempDir dir;
   test::write_bytes(dir / "net.onnx", "this is not a protobuf \x01\x02\x03");
   ModelCard card = load_model_card(write_text(dir / "card.yaml", card_yaml({})));
-  std::string msg = testing::error_of<std::runtime_error>([&] { OnnxSegmenter s(card); });
-  EXPECT_NE(msg.find((dir / "net.onnx").string()), std::string::npos) << msg;
-  EXPECT_NE(msg.find("not a readable ONNX network"), std::string::npos) << msg;
+  std::string msg = testing::error_of<std::runtime_error>([&] { DnnSegmenter s(card); });
+  EXPECT_NE(msg.find("model card " + (dir / "card.yaml").string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find((dir / "net.onnx").string() + "' (onnx) does not load: "), std::string::npos)
+      << msg;
 
   card.model_file = dir / "gone.onnx";
-  msg = testing::error_of<std::runtime_error>([&] { OnnxSegmenter s(card); });
+  msg = testing::error_of<std::runtime_error>([&] { DnnSegmenter s(card); });
   EXPECT_NE(msg.find((dir / "gone.onnx").string() + "' not found"), std::string::npos) << msg;
 }
 
-TEST(OnnxSegmenter, ClassCountMismatchNamesCardAndBothShapes) {
+// A network of another format runs through the same pre- and post-processing: a Caffe
+// network (a softmax over the three input channels, so no weights) whose output the
+// hand computation predicts.
+TEST(DnnSegmenter, CaffeNetworkRunsThroughTheSameCode) {
+  TempDir dir;
+  write_text(dir / "net.prototxt",
+             "name: 'channel_softmax'\n"
+             "input: 'data'\n"
+             "input_shape { dim: 1 dim: 3 dim: 2 dim: 4 }\n"
+             "layer { name: 'prob' type: 'Softmax' bottom: 'data' top: 'prob' }\n");
+  write_text(dir / "net.caffemodel", "");  // no layer has weights
+  CardFields f;
+  f.model = "net.caffemodel";
+  f.extra = "config: net.prototxt\n";
+  f.output = "probabilities";
+  DnnSegmenter segmenter(load_model_card(write_text(dir / "card.yaml", card_yaml(f))));
+  EXPECT_NE(segmenter.describe().find("(caffe)"), std::string::npos) << segmenter.describe();
+  const Segmentation s = segmenter.segment(uniform_image(kPixel));
+  // x = (R, G, B) / 255 on the rgb card; p = softmax(x).
+  std::vector<double> p{200.0 / 255, 100.0 / 255, 10.0 / 255};
+  double sum = 0;
+  for (double& v : p) sum += (v = std::exp(v));
+  for (int c = 1; c < 4; ++c) {
+    EXPECT_NEAR(probability(s, 3, 5, c), p[static_cast<std::size_t>(c - 1)] / sum, 1e-5);
+  }
+  EXPECT_EQ(s.labels.at<std::uint16_t>(3, 5), 1);
+}
+
+// What a user needs when OpenCV lacks a layer: its type, found in OpenCV's message.
+TEST(DnnSegmenter, UnsupportedLayerIsNamedByItsType) {
+  TempDir dir;
+  write_text(dir / "net.prototxt",
+             "name: 'exotic'\n"
+             "input: 'data'\n"
+             "input_shape { dim: 1 dim: 3 dim: 2 dim: 4 }\n"
+             "layer { name: 'mystery' type: 'FancyAttention' bottom: 'data' top: 'out' }\n");
+  write_text(dir / "net.caffemodel", "");
+  CardFields f;
+  f.model = "net.caffemodel";
+  f.extra = "config: net.prototxt\n";
+  const ModelCard card = load_model_card(write_text(dir / "card.yaml", card_yaml(f)));
+  const std::string msg = testing::error_of<std::runtime_error>([&] { DnnSegmenter s(card); });
+  EXPECT_NE(msg.find("model card " + (dir / "card.yaml").string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find((dir / "net.caffemodel").string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("unsupported layer type 'FancyAttention'"), std::string::npos) << msg;
+}
+
+// Damaged files of every format are errors naming the card, the file and OpenCV's message;
+// none crashes the process.
+TEST(DnnSegmenter, GarbageNetworkOfEachFormatIsReportedNotCrashed) {
+  TempDir dir;
+  std::string garbage = "\x08\x96\x01 not a network at all \xff\xfe\x00\x01";
+  for (int i = 0; i < 64; ++i) garbage += static_cast<char>((i * 37 + 11) & 0xff);
+  struct Case {
+    std::string model, config;
+  };
+  for (const Case& c : std::vector<Case>{{"net.onnx", ""},
+                                         {"net.t7", ""},
+                                         {"net.caffemodel", "net.prototxt"},
+                                         {"net.pb", ""},
+                                         {"net.weights", "net.cfg"}}) {
+    test::write_bytes(dir / c.model, garbage);
+    CardFields f;
+    f.model = c.model;
+    if (!c.config.empty()) {
+      test::write_bytes(dir / c.config, garbage);
+      f.extra = "config: " + c.config + "\n";
+    }
+    const ModelCard card = load_model_card(write_text(dir / "card.yaml", card_yaml(f)));
+    const std::string msg = testing::error_of<std::runtime_error>([&] { DnnSegmenter s(card); });
+    EXPECT_NE(msg.find("model card " + (dir / "card.yaml").string()), std::string::npos) << msg;
+    EXPECT_NE(msg.find((dir / c.model).string()), std::string::npos) << msg;
+    const auto said = msg.find(" does not load: ");
+    ASSERT_NE(said, std::string::npos) << msg;
+    EXPECT_GT(msg.size(), said + 20) << "OpenCV's message is missing: " << msg;
+  }
+}
+
+TEST(DnnSegmenter, ClassCountMismatchNamesCardAndBothShapes) {
   TempDir dir;
   CardFields f;
   f.names = "[a, b, c, d]";
@@ -255,7 +334,7 @@ TEST(OnnxSegmenter, ClassCountMismatchNamesCardAndBothShapes) {
   EXPECT_NE(msg.find("gives [1, 3, 2, 4]"), std::string::npos) << msg;
 }
 
-TEST(OnnxSegmenter, WrongInputImageThrows) {
+TEST(DnnSegmenter, WrongInputImageThrows) {
   TempDir dir;
   CardFields f;
   auto segmenter = make_segmenter(dir, f, affine_model(f));

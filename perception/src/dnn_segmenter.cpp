@@ -1,4 +1,4 @@
-#include "semap/perception/onnx_segmenter.hpp"
+#include "semap/perception/dnn_segmenter.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/dnn.hpp>
@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "dnn_network.hpp"
 #include "input_image.hpp"
 
 namespace semap::perception {
@@ -23,7 +24,7 @@ std::string shape_of(const cv::Mat& m) {
 }
 
 void check_card(const ModelCard& card) {
-  const std::string who = "OnnxSegmenter(" + card.card_file.string() + ")";
+  const std::string who = "DnnSegmenter(" + card.card_file.string() + ")";
   detail::require_storable_class_count(card.num_map_classes, who);
   if (card.classes.empty() || card.input_width < 1 || card.input_height < 1 || card.threads < 1) {
     throw std::invalid_argument(who + ": card without classes, input size or threads");
@@ -39,27 +40,9 @@ void check_card(const ModelCard& card) {
   }
 }
 
-cv::dnn::Net read_network(const ModelCard& card) {
-  const std::string where =
-      "model card " + card.card_file.string() + ": model file '" + card.model_file.string() + "'";
-  if (!std::filesystem::is_regular_file(card.model_file)) {
-    throw std::runtime_error(where + " not found");
-  }
-  cv::dnn::Net net;
-  try {
-    net = cv::dnn::readNetFromONNX(card.model_file.string());
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(where + " is not a readable ONNX network: " + e.err);
-  }
-  if (net.empty()) throw std::runtime_error(where + " holds no network");
-  net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-  net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-  return net;
-}
-
 }  // namespace
 
-struct OnnxSegmenter::Impl {
+struct DnnSegmenter::Impl {
   ModelCard card;
   cv::dnn::Net net;
   // Buffers reused from frame to frame.
@@ -71,7 +54,7 @@ struct OnnxSegmenter::Impl {
   std::vector<cv::Mat> map_planes;    // at the model's output size; plane 0: dropped mass
   std::vector<cv::Mat> image_planes;  // the same, resized to the camera image
 
-  explicit Impl(ModelCard c) : card(std::move(c)), net(read_network(card)) {
+  explicit Impl(ModelCard c) : card(std::move(c)), net(detail::read_network(card)) {
     const int shape[] = {1, 3, card.input_height, card.input_width};
     blob.create(4, shape, CV_32F);
     for (int k = 0; k < 3; ++k) {
@@ -187,7 +170,7 @@ struct OnnxSegmenter::Impl {
   }
 };
 
-OnnxSegmenter::OnnxSegmenter(ModelCard card) {
+DnnSegmenter::DnnSegmenter(ModelCard card) {
   check_card(card);
   // OpenCV's thread count is process-wide: the last segmenter built sets it for everyone.
   cv::setNumThreads(card.threads);
@@ -199,9 +182,10 @@ OnnxSegmenter::OnnxSegmenter(ModelCard card) {
   try {
     output = impl_->run(cv::Mat::zeros(c.input_height, c.input_width, CV_8UC3));
   } catch (const cv::Exception& e) {
-    throw std::runtime_error("model file '" + c.model_file.string() + "' fails on a [1, 3, " +
+    throw std::runtime_error("model card " + c.card_file.string() + ": model file '" +
+                             c.model_file.string() + "' fails on a [1, 3, " +
                              std::to_string(c.input_height) + ", " + std::to_string(c.input_width) +
-                             "] input: " + e.err);
+                             "] input: " + detail::explain_opencv_error(e));
   }
   const int classes = static_cast<int>(c.classes.size());
   if (output.dims != 4 || output.size[0] != 1 || output.size[1] != classes) {
@@ -212,21 +196,21 @@ OnnxSegmenter::OnnxSegmenter(ModelCard card) {
   }
 }
 
-OnnxSegmenter::~OnnxSegmenter() = default;
+DnnSegmenter::~DnnSegmenter() = default;
 
-Segmentation OnnxSegmenter::segment(const cv::Mat& bgr) {
-  detail::require_bgr_image(bgr, "OnnxSegmenter::segment");
+Segmentation DnnSegmenter::segment(const cv::Mat& bgr) {
+  detail::require_bgr_image(bgr, "DnnSegmenter::segment");
   cv::Mat output = impl_->run(bgr);
   impl_->map_class_mass(output);
   return impl_->label(impl_->at_image_size(bgr.size()), bgr.size());
 }
 
-int OnnxSegmenter::num_classes() const { return impl_->card.num_map_classes; }
+int DnnSegmenter::num_classes() const { return impl_->card.num_map_classes; }
 
-std::string OnnxSegmenter::describe() const {
+std::string DnnSegmenter::describe() const {
   const ModelCard& c = impl_->card;
-  return "onnx segmenter: " + c.model_file.string() + " at " + std::to_string(c.input_width) + "x" +
-         std::to_string(c.input_height) +
+  return "dnn segmenter: " + c.model_file.string() + " (" + std::string(format_name(c.format)) +
+         ") at " + std::to_string(c.input_width) + "x" + std::to_string(c.input_height) +
          (c.channel_order == ChannelOrder::kRgb ? " rgb, " : " bgr, ") +
          (c.output == ModelOutput::kLogits ? "logits, " : "probabilities, ") +
          std::to_string(c.classes.size()) + " model classes -> " +
@@ -234,6 +218,11 @@ std::string OnnxSegmenter::describe() const {
          " threads";
 }
 
-const ModelCard& OnnxSegmenter::card() const { return impl_->card; }
+const ModelCard& DnnSegmenter::card() const { return impl_->card; }
+
+cv::Mat DnnSegmenter::forward(const cv::Mat& bgr) {
+  detail::require_bgr_image(bgr, "DnnSegmenter::forward");
+  return impl_->run(bgr);
+}
 
 }  // namespace semap::perception
