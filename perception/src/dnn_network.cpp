@@ -1,8 +1,8 @@
 #include "dnn_network.hpp"
 
 #include <filesystem>
-#include <regex>
 #include <stdexcept>
+#include <string_view>
 
 namespace semap::perception::detail {
 
@@ -32,10 +32,15 @@ std::string explain_opencv_error(const cv::Exception& e) {
   // OpenCV 4.6 names the layer type in these forms: Caffe, TensorFlow, Darknet and the network
   // set-up `Can't create layer "name" of type "Type"`, ONNX `Node for layer 'name' of type
   // 'Type' wasn't initialized`, Torch7 `Unsupported Torch class "Type"`.
-  static const std::regex layer_type(R"((?:of type|Torch class) ["']([^"']+)["'])");
-  std::smatch match;
-  if (std::regex_search(e.err, match, layer_type)) {
-    return e.err + "; unsupported layer type '" + match[1].str() + "'";
+  // (Plain string search: std::regex trips GCC 12's -Wmaybe-uninitialized at -O1 under ASan.)
+  for (const std::string_view marker : {"of type ", "Torch class "}) {
+    const std::size_t at = e.err.find(marker);
+    if (at == std::string::npos) continue;
+    const std::size_t open = at + marker.size();
+    if (open >= e.err.size() || (e.err[open] != '"' && e.err[open] != '\'')) continue;
+    const std::size_t close = e.err.find_first_of("\"'", open + 1);
+    if (close == std::string::npos || close == open + 1) continue;
+    return e.err + "; unsupported layer type '" + e.err.substr(open + 1, close - open - 1) + "'";
   }
   return e.err;
 }
