@@ -1,32 +1,14 @@
 #include "dataset_report.hpp"
 
 #include <spdlog/fmt/fmt.h>
-#include <sys/resource.h>
 
 #include <fstream>
 
+#include "semap/common/json_text.hpp"
+#include "semap/common/process_usage.hpp"
 #include "semap/map_io/map_export.hpp"
 
 namespace semap::apps {
-
-namespace {
-
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += (static_cast<unsigned char>(c) < 0x20) ? ' ' : c;
-  }
-  return out + "\"";
-}
-
-double peak_rss_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
-}
-
-}  // namespace
 
 std::size_t write_dataset_outputs(const std::filesystem::path& out, onboard::Pipeline& pipeline,
                                   const onboard::DatasetRig& rig, double wall_s) {
@@ -64,7 +46,7 @@ std::size_t write_dataset_outputs(const std::filesystem::path& out, onboard::Pip
               unreadable, p.skipped, p.unpaired, p.bad_frames, p.without_pose, cloud_drops)
        << "  \"problems\": [";
   for (std::size_t i = 0; i < problems.size(); ++i) {
-    json << (i ? ", " : "") << quoted(problems[i].text());
+    json << (i ? ", " : "") << common::json_string(problems[i].text());
   }
   json << "],\n"
        << fmt::format(
@@ -79,7 +61,7 @@ std::size_t write_dataset_outputs(const std::filesystem::path& out, onboard::Pip
        << fmt::format(
               "  \"map\": {{\"blocks\": {}, \"observed_cells\": {}, \"occupied_cells\": {}}},\n",
               m.map.blocks, m.map.observed_cells, cells.size())
-       << fmt::format("  \"peak_rss_mb\": {:.1f},\n", peak_rss_mb())
+       << fmt::format("  \"peak_rss_mb\": {:.1f},\n", common::process_peak_rss_mib())
        << fmt::format("  \"wall_s\": {:.2f}\n", wall_s) << "}\n";
   if (!json) throw std::runtime_error("cannot write " + (out / "summary.json").string());
   return not_mapped + skipped_by_reader;

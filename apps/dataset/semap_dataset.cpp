@@ -48,8 +48,9 @@ perception::PinholeIntrinsics parse_intrinsics(const std::string& text) {
 // A map for indoor RGB-D (5 cm cells, 5 m range) unless --map names the robot's map: section.
 onboard::OnboardConfig pipeline_config(const Options& o, int map_classes) {
   onboard::OnboardConfig c;
-  if (!o.map_config.empty()) c = onboard::load_onboard_config(o.map_config);
-  if (o.map_config.empty()) {
+  if (!o.map_config.empty()) {
+    c = onboard::load_onboard_config(o.map_config);
+  } else {
     auto& p = c.map.params;
     p.resolution = 0.05f;
     p.ell = 0.15f;

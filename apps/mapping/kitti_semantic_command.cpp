@@ -1,6 +1,5 @@
 #include "kitti_semantic_command.hpp"
 
-#include <sys/resource.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -13,6 +12,7 @@
 #include "map_options.hpp"
 #include "progress_meter.hpp"
 #include "scan_timing.hpp"
+#include "semap/common/process_usage.hpp"
 #include "semap/map_io/kitti_iou_table.hpp"
 #include "semap/map_io/kitti_semantic_eval.hpp"
 
@@ -36,13 +36,6 @@ struct SemanticOptions {
 
 const char* row_name(mapping::MapMethod method) {
   return method == mapping::MapMethod::kBki ? "S-BKI" : "S-CSM";
-}
-
-// The largest resident set of the process so far (Linux reports KiB).
-double peak_memory_mib() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
 void print_settings(const SemanticOptions& o, const map_io::KittiSemanticConfig& config,
@@ -83,7 +76,8 @@ void print_result(const map_io::KittiSemanticResult& r, double wall_seconds) {
     std::printf("map %s blocks %zu cells %zu observed_cells %zu bytes %zu\n", row_name(map.method),
                 map.stats.blocks, map.stats.cells, map.stats.observed_cells, map.stats.bytes);
   }
-  std::printf("wall_seconds %.2f\npeak_memory_mib %.1f\n", wall_seconds, peak_memory_mib());
+  std::printf("wall_seconds %.2f\npeak_memory_mib %.1f\n", wall_seconds,
+              common::process_peak_rss_mib());
 }
 
 int run(const CLI::App& command, const SemanticOptions& o) {

@@ -15,11 +15,14 @@
 #include <string>
 #include <vector>
 
+#include "semap/common/json_text.hpp"
 #include "semap/perception/dnn_segmenter.hpp"
 #include "semap/perception/model_card.hpp"
 #include "semap/perception/segmentation_views.hpp"
 
 namespace {
+
+using semap::common::json_string;
 
 namespace fs = std::filesystem;
 namespace sp = semap::perception;
@@ -32,23 +35,6 @@ struct Options {
   std::string check;
   int repeat = 3;
 };
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 std::string shape_text(const std::vector<int>& shape) {
   std::string s = "[";

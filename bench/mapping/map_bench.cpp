@@ -8,12 +8,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "semap/common/process_usage.hpp"
 #include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/semantic_map.hpp"
 #include "synthetic_lidar.hpp"
@@ -25,14 +25,6 @@ using semap::mapping::MapMethod;
 using semap::mapping::MapParams;
 using semap::mapping::SemanticMap;
 using Clock = std::chrono::steady_clock;
-
-// CPU time of the whole process: on a shared machine it shows the work done, where wall
-// time also counts the waits for a core.
-double process_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
-}
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -123,7 +115,7 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, MapMethod method, To
     double training = -1;
     std::size_t points = 0;
     semap::mapping::InsertPhases phases;
-    const double cpu0 = process_cpu_seconds();
+    const double cpu0 = semap::common::process_cpu_seconds();
     const auto start = Clock::now();
     if (path != ToyPath::kBatch) {
       training = 0;
@@ -141,7 +133,7 @@ ToyTiming time_toy(const std::vector<LabeledCloud>& clouds, MapMethod method, To
       }
     }
     const double total = seconds_since(start);
-    const double cpu = process_cpu_seconds() - cpu0;
+    const double cpu = semap::common::process_cpu_seconds() - cpu0;
     if (total < t.best_total) {
       t.best_total = total;
       t.cpu = cpu;
@@ -226,7 +218,7 @@ void lidar_figures(int scans) {
   for (int s = 0; s < scans; ++s) {
     const LabeledCloud cloud = lidar.scan(s);
     points += cloud.size();
-    const double cpu0 = process_cpu_seconds();
+    const double cpu0 = semap::common::process_cpu_seconds();
     const auto start = Clock::now();
     // The same two steps as map.insert(cloud, origin), timed apart.
     const auto set = semap::mapping::build_training_set(cloud, cloud.origin, map.params());
@@ -235,7 +227,7 @@ void lidar_figures(int scans) {
     training += map.insert(set).training_points;
     times.push_back(seconds_since(start));
     fusion_times.push_back(times.back() - built);
-    cpu += process_cpu_seconds() - cpu0;
+    cpu += semap::common::process_cpu_seconds() - cpu0;
   }
   std::vector<double> sorted = times;
   std::sort(sorted.begin(), sorted.end());

@@ -4,7 +4,6 @@
 // 15 Hz with YUYV colour and aligned Z16 depth while a pose thread drives a circle.
 // The last line is parsed by scripts:
 //   steady state: F frames/s mapped, latency p50 A ms p99 B ms, cpu C cores
-#include <sys/resource.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 #include <vector>
 
 #include "bench_inputs.hpp"
+#include "semap/common/process_usage.hpp"
 #include "semap/drivers/frame_convert.hpp"
 #include "semap/drivers/jpeg_decoder.hpp"
 #include "semap/mapping/cloud_transform.hpp"
@@ -55,15 +55,6 @@ struct Options {
   std::string infer = "320x240";
   std::filesystem::path model_card;  // a trained network instead of the synthetic one
 };
-
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  const auto s = [](const timeval& t) {
-    return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6;
-  };
-  return s(u.ru_utime) + s(u.ru_stime);
-}
 
 void row(const std::string& what, const bench::Spread& s) {
   std::printf("  %-60s p50 %7.2f ms  p90 %7.2f ms\n", what.c_str(), s.p50, s.p90);
@@ -192,7 +183,7 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   perception.start();
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
 
-  const double cpu0 = cpu_seconds();
+  const double cpu0 = semap::common::process_cpu_seconds();
   const auto start = Clock::now();
   const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / kCameraHz));
   const auto frames = static_cast<std::uint32_t>(o.seconds * kCameraHz);
@@ -206,7 +197,7 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   }
   std::this_thread::sleep_until(start + frames * period);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  const double cpu = cpu_seconds() - cpu0;
+  const double cpu = semap::common::process_cpu_seconds() - cpu0;
   const auto m = mapping.stats();
   perception.stop();
   mapping.stop();

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "semap/common/logging.hpp"
+#include "semap/common/process_usage.hpp"
 #include "semap/mapping/smap_io.hpp"
 #include "semap/onboard/run_summary.hpp"
 #include "semap/onboard/segmenter_factory.hpp"
@@ -129,7 +130,7 @@ void Pipeline::start() {
   rig_->start();
   running_ = true;
   started_ = common::Stamp::now();
-  cpu_at_start_s_ = process_cpu_seconds();
+  cpu_at_start_s_ = common::process_cpu_seconds();
   next_health_ = started_;
   next_progress_ = started_ + 5.0;
   common::logger("onboard")->info("running {}", rig_->describe());
@@ -170,7 +171,7 @@ void Pipeline::stop() {
   if (dds_) dds_->stop();  // the map's last changes go out
   for (PipelineObserver* o : observers_) o->on_stopped();
   wall_s_ = common::seconds_between(common::Stamp::now(), started_);
-  cpu_cores_ = wall_s_ > 0.0 ? (process_cpu_seconds() - cpu_at_start_s_) / wall_s_ : 0.0;
+  cpu_cores_ = wall_s_ > 0.0 ? (common::process_cpu_seconds() - cpu_at_start_s_) / wall_s_ : 0.0;
 }
 
 bool Pipeline::succeeded() const {

@@ -39,15 +39,6 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
   return figures;
 }
 
-double process_cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  const auto seconds = [](const timeval& t) {
-    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
-  };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
-
 std::string Progress::line(double t, const EstimationStageStats& est,
                            const PerceptionStageStats& perception, const MappingStageStats& map,
                            const Rings& r) {

@@ -39,9 +39,6 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
                                         const PerceptionStage* perception,
                                         const MappingStage& mapping, const DdsOutputs& dds);
 
-// CPU time this process has used so far, user + system, in seconds.
-double process_cpu_seconds();
-
 // Rates over the last interval, ring depths and drops: the progress line every few seconds.
 class Progress {
  public:
