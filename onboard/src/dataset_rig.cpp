@@ -6,22 +6,64 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/drivers/frame_convert.hpp"
+#include "semap/perception/datasets/velodyne_bin.hpp"
 
 namespace semap::onboard {
+
+namespace {
+
+std::vector<DatasetFrame> rgbd_frames(const perception::datasets::RgbdSequence& sequence,
+                                      const Eigen::Isometry3f& body_from_optical) {
+  const Eigen::Isometry3d optical_from_body = body_from_optical.cast<double>().inverse();
+  std::vector<DatasetFrame> frames;
+  frames.reserve(sequence.frames.size());
+  for (const auto& f : sequence.frames) {
+    frames.push_back({f.colour, f.depth, {}, f.world_from_camera * optical_from_body});
+  }
+  return frames;
+}
+
+std::vector<DatasetFrame> lidar_frames(
+    const perception::datasets::KittiOdometrySequence& sequence,
+    const Eigen::Isometry3f& body_from_lidar) {
+  const Eigen::Isometry3d lidar_from_body = body_from_lidar.cast<double>().inverse();
+  std::vector<DatasetFrame> frames;
+  frames.reserve(sequence.frames.size());
+  for (const auto& f : sequence.frames) {
+    frames.push_back({f.image.value_or(std::filesystem::path{}), {}, f.scan,
+                      f.world_from_lidar * lidar_from_body});
+  }
+  return frames;
+}
+
+}  // namespace
 
 DatasetRig::DatasetRig(perception::datasets::RgbdSequence sequence, std::string name,
                        const Eigen::Isometry3f& body_from_optical, DatasetSelection selection,
                        const SensorRings& rings)
-    : sequence_(std::move(sequence)),
+    : DatasetRig(rgbd_frames(sequence, body_from_optical), std::move(sequence.problems),
+                 std::move(name), selection, rings) {}
+
+DatasetRig::DatasetRig(const perception::datasets::KittiOdometrySequence& sequence,
+                       std::string name, const Eigen::Isometry3f& body_from_lidar,
+                       DatasetSelection selection, const SensorRings& rings)
+    : DatasetRig(lidar_frames(sequence, body_from_lidar), sequence.problems, std::move(name),
+                 selection, rings) {}
+
+DatasetRig::DatasetRig(std::vector<DatasetFrame> frames,
+                       std::vector<perception::datasets::InputProblem> reader_problems,
+                       std::string name, DatasetSelection selection, const SensorRings& rings)
+    : frames_(std::move(frames)),
+      reader_problems_(reader_problems.size()),
       name_(std::move(name)),
-      optical_from_body_(body_from_optical.cast<double>().inverse()),
       rings_(rings),
-      problems_(sequence_.problems) {
+      problems_(std::move(reader_problems)) {
   if (selection.stride == 0) throw std::invalid_argument("dataset: stride must be at least 1");
-  const std::size_t end = std::min(selection.last, sequence_.frames.size() - 1);
-  for (std::size_t i = selection.first; i <= end && i < sequence_.frames.size();
+  for (std::size_t i = selection.first; i < frames_.size() && i <= selection.last;
        i += selection.stride) {
     selected_.push_back(i);
+    has_colour_ = has_colour_ || !frames_[i].colour.empty();
+    has_scans_ = has_scans_ || !frames_[i].scan.empty();
   }
 }
 
@@ -29,7 +71,7 @@ DatasetRig::~DatasetRig() { stop(); }
 
 std::string DatasetRig::describe() const {
   return "on the dataset " + name_ + " (" + std::to_string(selected_.size()) + " of " +
-         std::to_string(sequence_.frames.size()) + " frames)";
+         std::to_string(frames_.size()) + " frames)";
 }
 
 void DatasetRig::set_taps(RawTaps) {
@@ -51,12 +93,12 @@ void DatasetRig::summary(std::vector<std::string>& lines) const {
   std::size_t unreadable = 0;
   {
     std::lock_guard lock(mutex_);
-    unreadable = problems_.size() - sequence_.problems.size();
+    unreadable = problems_.size() - reader_problems_;
   }
   lines.push_back("dataset          : " + name_ + ", " + std::to_string(handed_over()) + " of " +
                   std::to_string(selected_.size()) + " selected frames handed over, " +
                   std::to_string(unreadable) + " unreadable, " +
-                  std::to_string(sequence_.problems.size()) + " skipped by the reader");
+                  std::to_string(reader_problems_) + " skipped by the reader");
 }
 
 std::vector<perception::datasets::InputProblem> DatasetRig::problems() const {
@@ -75,9 +117,9 @@ void DatasetRig::run(std::stop_token stop) {
   std::uint32_t sequence = 0;
   for (const std::size_t index : selected_) {
     if (stop.stop_requested()) break;
-    if (!hand_over(sequence_.frames[index], sequence++)) continue;
-    ++handed.colour_frames;
-    handed_.store(static_cast<std::size_t>(handed.colour_frames), std::memory_order_release);
+    if (!hand_over(frames_[index], sequence++)) continue;
+    ++handed.frames;
+    handed_.store(static_cast<std::size_t>(handed.frames), std::memory_order_release);
     // Frame by frame: the rings drop their oldest entries when full, and the perception stage
     // passes over all but the newest frame it holds.
     while (taken_ && !taken_(handed) && !stop.stop_requested()) {
@@ -87,34 +129,59 @@ void DatasetRig::run(std::stop_token stop) {
   finished_.store(true, std::memory_order_release);
 }
 
-bool DatasetRig::hand_over(const perception::datasets::RgbdFrame& frame, std::uint32_t sequence) {
-  const cv::Mat colour = cv::imread(frame.colour.string(), cv::IMREAD_COLOR);
-  if (colour.empty()) {
-    problem(frame.colour, "cannot read the colour image");
-    return false;
+bool DatasetRig::hand_over(const DatasetFrame& frame, std::uint32_t sequence) {
+  cv::Mat colour;
+  if (!frame.colour.empty()) {
+    colour = cv::imread(frame.colour.string(), cv::IMREAD_COLOR);
+    if (colour.empty()) {
+      problem(frame.colour, "cannot read the colour image");
+      return false;
+    }
   }
-  const cv::Mat depth = cv::imread(frame.depth.string(), cv::IMREAD_UNCHANGED);
-  if (depth.empty()) {
-    problem(frame.depth, "cannot read the depth image");
-    return false;
+  cv::Mat depth;
+  if (!frame.depth.empty()) {
+    depth = cv::imread(frame.depth.string(), cv::IMREAD_UNCHANGED);
+    if (depth.empty()) {
+      problem(frame.depth, "cannot read the depth image");
+      return false;
+    }
+    if (depth.type() != CV_16UC1) {
+      problem(frame.depth, "the depth image is not 16-bit single-channel");
+      return false;
+    }
+    if (depth.size() != colour.size()) {
+      problem(frame.depth, "the depth image's size differs from the colour image's");
+      return false;
+    }
   }
-  if (depth.type() != CV_16UC1) {
-    problem(frame.depth, "the depth image is not 16-bit single-channel");
-    return false;
-  }
-  if (depth.size() != colour.size()) {
-    problem(frame.depth, "the depth image's size differs from the colour image's");
-    return false;
+  common::PointScan scan;
+  if (!frame.scan.empty()) {
+    try {
+      for (const Eigen::Vector4f& p : perception::datasets::read_velodyne_bin(frame.scan)) {
+        scan.points.push_back(p.head<3>());
+      }
+    } catch (const perception::datasets::DatasetError& e) {
+      problem(frame.scan, e.what());
+      return false;
+    }
   }
   const common::Stamp stamp = common::Stamp::now();
-  const Eigen::Isometry3d world_from_body = frame.world_from_camera * optical_from_body_;
   estimation::StampedPose pose;
   pose.stamp = stamp;
-  pose.orientation = Eigen::Quaterniond(world_from_body.linear()).normalized();
-  pose.position = world_from_body.translation();
+  pose.orientation = Eigen::Quaterniond(frame.world_from_body.linear()).normalized();
+  pose.position = frame.world_from_body.translation();
   rings_.poses.append(std::span(&pose, 1));
-  rings_.depth.try_push(drivers::to_frame(depth, common::PixelFormat::kZ16, stamp, sequence));
-  rings_.colour.try_push(drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+  if (!depth.empty()) {
+    rings_.depth.try_push(drivers::to_frame(depth, common::PixelFormat::kZ16, stamp, sequence));
+  }
+  if (!frame.scan.empty()) {
+    scan.stamp = stamp;
+    scan.sequence = sequence;
+    rings_.scans.try_push(std::move(scan));
+  }
+  if (!colour.empty()) {
+    rings_.colour.try_push(drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+  }
   return true;
 }
 

@@ -8,6 +8,8 @@
 #include "semap/drivers/frame_convert.hpp"
 #include "semap/mapping/cloud_transform.hpp"
 #include "semap/perception/depth_cloud.hpp"
+#include "semap/perception/geometry_segmenter.hpp"
+#include "semap/perception/lidar_projection.hpp"
 #include "semap/perception/stereo_depth.hpp"
 
 namespace semap::onboard {
@@ -21,12 +23,71 @@ std::string frame_name(const common::ImageFrame& f) {
          std::to_string(f.height) + ", stamp " + std::to_string(f.stamp.ns) + " ns)";
 }
 
+std::string scan_name(const common::PointScan& s) {
+  return "scan " + std::to_string(s.sequence) + " (" + std::to_string(s.points.size()) +
+         " points, stamp " + std::to_string(s.stamp.ns) + " ns)";
+}
+
+// Hands the newest `leads` item that has a partner within `tolerance` (the partner nearest in
+// time) to `process`, passing over the older ones (skipped) and the partners before the one
+// used (partner_unused). Without a pair, drops what can never pair: items older than the other
+// stream's newest minus the tolerance, and items beyond `capacity` (a stream that stopped
+// delivering must not let the other pile up).
+template <class Lead, class Partner, class Process>
+bool process_newest_pair(std::deque<Lead>& leads, std::deque<Partner>& partners,
+                         double tolerance, std::size_t lead_capacity,
+                         std::size_t partner_capacity, PerceptionStageStats& figures,
+                         Process&& process) {
+  for (auto lead = leads.rbegin(); lead != leads.rend(); ++lead) {
+    auto best = partners.end();
+    double best_dt = tolerance;
+    for (auto p = partners.begin(); p != partners.end(); ++p) {
+      const double dt = std::abs(common::seconds_between(p->stamp, lead->stamp));
+      if (dt <= best_dt) {
+        best_dt = dt;
+        best = p;
+      }
+    }
+    if (best == partners.end()) continue;
+    const auto index = static_cast<std::size_t>(leads.rend() - lead) - 1;
+    figures.skipped += index;
+    const Lead taken = std::move(*lead);
+    const Partner partner = std::move(*best);
+    leads.erase(leads.begin(), leads.begin() + static_cast<std::ptrdiff_t>(index) + 1);
+    // Partners before the one used are too old for any later lead.
+    figures.partner_unused += static_cast<std::uint64_t>(best - partners.begin());
+    partners.erase(partners.begin(), best + 1);
+    process(taken, partner);
+    return true;
+  }
+  const auto expire = [&](auto& mine, const auto& other, std::uint64_t& count) {
+    if (other.empty()) return;
+    const common::Stamp horizon = other.back().stamp + (-tolerance);
+    while (!mine.empty() && mine.front().stamp < horizon) {
+      mine.pop_front();
+      ++count;
+    }
+  };
+  expire(leads, partners, figures.unpaired);
+  expire(partners, leads, figures.partner_unused);
+  while (leads.size() > lead_capacity) {
+    leads.pop_front();
+    ++figures.unpaired;
+  }
+  while (partners.size() > partner_capacity) {
+    partners.pop_front();
+    ++figures.partner_unused;
+  }
+  return false;
+}
+
 }  // namespace
 
 PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& depth,
                                  std::unique_ptr<perception::Segmenter> segmenter,
                                  common::SpscRing<common::ImageFrame>& colour,
                                  common::SpscRing<common::ImageFrame>* depth_frames,
+                                 common::SpscRing<common::PointScan>* scans,
                                  const SharedPoseHistory& poses,
                                  common::SpscRing<common::LabeledCloud>& clouds)
     : camera_(camera),
@@ -34,12 +95,17 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
       segmenter_(std::move(segmenter)),
       colour_ring_(colour),
       depth_ring_(depth_frames),
+      scan_ring_(scans),
       poses_(poses),
       cloud_ring_(clouds),
       body_from_optical_(camera.body_from_optical()) {
   if (!segmenter_) throw std::invalid_argument("perception stage: no segmenter");
   if (depth_.source == DepthSource::kAligned && !depth_ring_) {
     throw std::invalid_argument("perception stage: aligned depth needs a depth frame ring");
+  }
+  if (depth_.source == DepthSource::kLidar) {
+    if (!scan_ring_) throw std::invalid_argument("perception stage: LiDAR needs a scan ring");
+    whole_scans_ = dynamic_cast<const perception::GeometrySegmenter*>(segmenter_.get()) != nullptr;
   }
   if (depth_.source == DepthSource::kStereo) {
     stereo_ = std::make_unique<perception::StereoDepth>(
@@ -59,13 +125,21 @@ PerceptionStageStats PerceptionStage::stats() const { return stage_.stats(); }
 
 std::uint32_t PerceptionStage::queue_depth() const {
   const std::size_t depth = depth_ring_ ? depth_ring_->size() : 0;
-  return static_cast<std::uint32_t>(colour_ring_.size() + depth);
+  const std::size_t scans = scan_ring_ ? scan_ring_->size() : 0;
+  return static_cast<std::uint32_t>(colour_ring_.size() + depth + scans);
 }
 
 std::string PerceptionStage::describe() const {
-  const std::string depth =
-      stereo_ ? "stereo (" + depth_.stereo_calibration.string() + ")" : "aligned Z16 depth";
-  return segmenter_->describe() + ", " + depth;
+  switch (depth_.source) {
+    case DepthSource::kStereo:
+      return segmenter_->describe() + ", stereo (" + depth_.stereo_calibration.string() + ")";
+    case DepthSource::kLidar:
+      return segmenter_->describe() +
+             (whole_scans_ ? ", whole LiDAR scans" : ", LiDAR scans projected into the image");
+    case DepthSource::kAligned:
+      break;
+  }
+  return segmenter_->describe() + ", aligned Z16 depth";
 }
 
 void PerceptionStage::run(std::stop_token stop) {
@@ -77,11 +151,13 @@ void PerceptionStage::run(std::stop_token stop) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   auto& figures = stage_.figures();
-  figures.unpaired += colour_pending_.size();
-  figures.depth_unused += depth_pending_.size();
+  const bool lidar = depth_.source == DepthSource::kLidar;
+  figures.unpaired += lidar ? scan_pending_.size() : colour_pending_.size();
+  figures.partner_unused += lidar ? colour_pending_.size() : depth_pending_.size();
   figures.without_pose += unposed_.size();
   colour_pending_.clear();
   depth_pending_.clear();
+  scan_pending_.clear();
   unposed_.clear();
   share_stats();
 }
@@ -97,10 +173,11 @@ bool PerceptionStage::step() {
 bool PerceptionStage::take_frames() {
   bool any = false;
   common::ImageFrame frame;
+  const bool lidar = depth_.source == DepthSource::kLidar;
   while (colour_ring_.try_pop(frame)) {
     if (tap_) tap_(frame, false);
     colour_pending_.push_back(std::move(frame));
-    ++stage_.figures().frames;
+    if (!lidar) ++stage_.figures().frames;
     any = true;
   }
   while (depth_ring_ && depth_ring_->try_pop(frame)) {
@@ -108,86 +185,97 @@ bool PerceptionStage::take_frames() {
     depth_pending_.push_back(std::move(frame));
     any = true;
   }
+  common::PointScan scan;
+  while (scan_ring_ && scan_ring_->try_pop(scan)) {
+    scan_pending_.push_back(std::move(scan));
+    ++stage_.figures().frames;
+    any = true;
+  }
   return any;
 }
 
-// Picks the newest colour frame that can be processed now and passes over the older ones.
-// With a separate depth device, a colour frame pairs with the depth frame nearest in time
-// within the sync tolerance; one that can no longer get a partner is dropped.
+// Picks the newest frame that can be processed now and passes over the older ones. A colour
+// frame pairs with the depth frame of a separate depth device nearest in time, a LiDAR scan
+// with the colour frame nearest in time, within the sync tolerance.
 bool PerceptionStage::process_next() {
-  if (colour_pending_.empty()) return false;
-  if (depth_.source != DepthSource::kAligned) {
-    stage_.figures().skipped += colour_pending_.size() - 1;
-    const common::ImageFrame colour = std::move(colour_pending_.back());
-    colour_pending_.clear();
-    process(colour, nullptr);
-    return true;
-  }
-  const double tolerance = depth_.sync_tolerance_s;
-  // Newest colour frame with a depth partner.
-  for (auto c = colour_pending_.rbegin(); c != colour_pending_.rend(); ++c) {
-    auto best = depth_pending_.end();
-    double best_dt = tolerance;
-    for (auto d = depth_pending_.begin(); d != depth_pending_.end(); ++d) {
-      const double dt = std::abs(common::seconds_between(d->stamp, c->stamp));
-      if (dt <= best_dt) {
-        best_dt = dt;
-        best = d;
+  auto& figures = stage_.figures();
+  switch (depth_.source) {
+    case DepthSource::kStereo: {
+      if (colour_pending_.empty()) return false;
+      figures.skipped += colour_pending_.size() - 1;
+      const common::ImageFrame colour = std::move(colour_pending_.back());
+      colour_pending_.clear();
+      process(colour, nullptr);
+      return true;
+    }
+    case DepthSource::kLidar: {
+      if (whole_scans_) {
+        figures.partner_unused += colour_pending_.size();
+        colour_pending_.clear();
+        if (scan_pending_.empty()) return false;
+        figures.skipped += scan_pending_.size() - 1;
+        const common::PointScan scan = std::move(scan_pending_.back());
+        scan_pending_.clear();
+        process_scan(scan, nullptr);
+        return true;
       }
+      return process_newest_pair(
+          scan_pending_, colour_pending_, depth_.sync_tolerance_s, scan_ring_->capacity(),
+          colour_ring_.capacity(), figures,
+          [this](const common::PointScan& scan, const common::ImageFrame& colour) {
+            process_scan(scan, &colour);
+          });
     }
-    if (best == depth_pending_.end()) continue;
-    const auto index = static_cast<std::size_t>(colour_pending_.rend() - c) - 1;
-    stage_.figures().skipped += index;
-    const common::ImageFrame colour = std::move(*c);
-    const common::ImageFrame depth = std::move(*best);
-    colour_pending_.erase(colour_pending_.begin(),
-                          colour_pending_.begin() + static_cast<std::ptrdiff_t>(index) + 1);
-    // Depth frames before the partner are too old for any later colour frame.
-    stage_.figures().depth_unused += static_cast<std::uint64_t>(best - depth_pending_.begin());
-    depth_pending_.erase(depth_pending_.begin(), best + 1);
-    process(colour, &depth);
-    return true;
+    case DepthSource::kAligned:
+      break;
   }
-  // No pair yet: drop what can never pair (the other stream is already past it).
-  const auto expire = [&](std::deque<common::ImageFrame>& mine,
-                          const std::deque<common::ImageFrame>& other, std::uint64_t& count) {
-    if (other.empty()) return;
-    const common::Stamp horizon = other.back().stamp + (-tolerance);
-    while (!mine.empty() && mine.front().stamp < horizon) {
-      mine.pop_front();
-      ++count;
-    }
-  };
-  expire(colour_pending_, depth_pending_, stage_.figures().unpaired);
-  expire(depth_pending_, colour_pending_, stage_.figures().depth_unused);
-  // A depth device that stopped delivering must not let colour frames pile up.
-  while (colour_pending_.size() > colour_ring_.capacity()) {
-    colour_pending_.pop_front();
-    ++stage_.figures().unpaired;
-  }
-  while (depth_pending_.size() > depth_ring_->capacity()) {
-    depth_pending_.pop_front();
-    ++stage_.figures().depth_unused;
-  }
-  return false;
+  return process_newest_pair(
+      colour_pending_, depth_pending_, depth_.sync_tolerance_s, colour_ring_.capacity(),
+      depth_ring_->capacity(), figures,
+      [this](const common::ImageFrame& colour, const common::ImageFrame& depth) {
+        process(colour, &depth);
+      });
 }
 
-void PerceptionStage::reject(const common::ImageFrame& frame, const std::string& why) {
+void PerceptionStage::reject(const std::string& frame, const std::string& why) {
   ++stage_.figures().bad_frames;
   // One line per bad frame would flood the log at camera rates: the first few and then every
   // hundredth, each with its count.
   if (stage_.figures().bad_frames <= 5 || stage_.figures().bad_frames % 100 == 0) {
     common::logger("perception")
-        ->warn("{} rejected ({} so far): {}", frame_name(frame), stage_.figures().bad_frames, why);
+        ->warn("{} rejected ({} so far): {}", frame, stage_.figures().bad_frames, why);
   }
 }
 
-void PerceptionStage::process(const common::ImageFrame& colour, const common::ImageFrame* depth) {
+cv::Mat PerceptionStage::colour_image(const common::ImageFrame& colour) {
   cv::Mat image = drivers::to_mat(colour, jpeg_);
-  if (image.empty()) return reject(colour, "truncated frame or corrupt JPEG");
+  if (image.empty()) {
+    reject(frame_name(colour), "truncated frame or corrupt JPEG");
+    return {};
+  }
   if (image.type() == CV_8UC1) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
-  if (image.type() != CV_8UC3) return reject(colour, "not a colour or grey image");
+  if (image.type() != CV_8UC3) {
+    reject(frame_name(colour), "not a colour or grey image");
+    return {};
+  }
+  return image;
+}
 
+perception::Segmentation PerceptionStage::segment(const common::ImageFrame& colour,
+                                                  const cv::Mat& image) {
+  const auto t0 = std::chrono::steady_clock::now();
+  perception::Segmentation segmentation = segmenter_->segment(image);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stage_.figures().segment_seconds_total += seconds;
+  stage_.figures().segment_seconds_max = std::max(stage_.figures().segment_seconds_max, seconds);
+  if (observer_) observer_(colour.sequence, colour.stamp, image, segmentation);
+  return segmentation;
+}
+
+void PerceptionStage::process(const common::ImageFrame& colour, const common::ImageFrame* depth) {
+  cv::Mat image = colour_image(colour);
+  if (image.empty()) return;
   perception::PinholeIntrinsics intrinsics = camera_.intrinsics;
   Eigen::Isometry3f body_from_optical = body_from_optical_;
   cv::Mat depth_m;
@@ -200,32 +288,52 @@ void PerceptionStage::process(const common::ImageFrame& colour, const common::Im
       body_from_optical.linear() = body_from_optical.linear() * frame.left_from_rectified;
     } else {
       if (depth->format != common::PixelFormat::kZ16) {
-        return reject(*depth, "depth frame is not Z16");
+        return reject(frame_name(*depth), "depth frame is not Z16");
       }
       const cv::Mat z16 = drivers::to_mat(*depth, jpeg_);
-      if (z16.empty()) return reject(*depth, "truncated depth frame");
+      if (z16.empty()) return reject(frame_name(*depth), "truncated depth frame");
       depth_m = perception::depth_metres(z16, depth_.depth_scale);
     }
-    const auto t0 = std::chrono::steady_clock::now();
-    const perception::Segmentation segmentation = segmenter_->segment(image);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    stage_.figures().segment_seconds_total += seconds;
-    stage_.figures().segment_seconds_max = std::max(stage_.figures().segment_seconds_max, seconds);
-    if (observer_) observer_(colour.sequence, colour.stamp, image, segmentation);
-    BodyCloud body{
-        perception::cloud_from_depth(depth_m, segmentation, intrinsics, body_from_optical,
-                                     depth_.points, stage_.figures().dropped),
-        colour.sequence};
-    body.cloud.stamp = colour.stamp;
-    if (unposed_.size() == kMaxUnposed) {
-      unposed_.pop_front();  // the filter has stalled; keep the newest
-      ++stage_.figures().without_pose;
-    }
-    unposed_.push_back(std::move(body));
+    const perception::Segmentation segmentation = segment(colour, image);
+    queue_for_pose(perception::cloud_from_depth(depth_m, segmentation, intrinsics,
+                                                body_from_optical, depth_.points,
+                                                stage_.figures().dropped),
+                   colour.stamp, colour.sequence);
   } catch (const std::exception& e) {
-    reject(colour, e.what());
+    reject(frame_name(colour), e.what());
   }
+}
+
+void PerceptionStage::process_scan(const common::PointScan& scan,
+                                   const common::ImageFrame* colour) {
+  auto& drops = stage_.figures().dropped;
+  const LidarConfig& lidar = depth_.lidar;
+  try {
+    if (!colour) {
+      return queue_for_pose(
+          perception::occupied_lidar_points(scan.points, segmenter_->num_classes(),
+                                            lidar.body_from_lidar, depth_.points, drops),
+          scan.stamp, scan.sequence);
+    }
+    const cv::Mat image = colour_image(*colour);
+    if (image.empty()) return;
+    const perception::Segmentation segmentation = segment(*colour, image);
+    queue_for_pose(perception::label_lidar_points(scan.points, segmentation, lidar.camera,
+                                                  lidar.body_from_lidar, depth_.points, drops),
+                   scan.stamp, scan.sequence);
+  } catch (const std::exception& e) {
+    reject(scan_name(scan), e.what());
+  }
+}
+
+void PerceptionStage::queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp,
+                                     std::uint32_t sequence) {
+  body_cloud.stamp = stamp;
+  if (unposed_.size() == kMaxUnposed) {
+    unposed_.pop_front();  // the filter has stalled; keep the newest
+    ++stage_.figures().without_pose;
+  }
+  unposed_.push_back(BodyCloud{std::move(body_cloud), sequence});
 }
 
 bool PerceptionStage::pose_clouds() {

@@ -51,9 +51,11 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
       gnss_ring_(config.gnss.ring, OverflowPolicy::kDropOldest),
       colour_ring_(config.camera.ring, OverflowPolicy::kDropOldest),
       depth_ring_(config.depth.ring, OverflowPolicy::kDropOldest),
+      scan_ring_(config.depth.ring, OverflowPolicy::kDropOldest),
       cloud_ring_(config.depth.ring, OverflowPolicy::kDropOldest),
       poses_(config.estimator.history),
-      rig_(make_rig(SensorRings{imu_ring_, gnss_ring_, colour_ring_, depth_ring_, poses_})) {
+      rig_(make_rig(
+          SensorRings{imu_ring_, gnss_ring_, colour_ring_, depth_ring_, scan_ring_, poses_})) {
   auto log = common::logger("onboard");
   const bool inekf = config_.estimator.filter == estimation::FilterKind::kLeftInekf;
   log->info(
@@ -64,13 +66,14 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
   // The configuration has read the model card, palette and calibration; a network OpenCV then
   // fails to load leaves the robot localising without a map: localisation must not depend on
   // the camera half.
-  if (rig_->has_camera()) {
+  if (rig_->has_camera() || rig_->has_lidar()) {
     try {
+      const DepthSource source = config_.depth.source;
       perception_ = std::make_unique<PerceptionStage>(
           config_.camera, config_.depth,
           make_segmenter(config_.segmenter, config_.map.params.num_classes), colour_ring_,
-          config_.depth.source == DepthSource::kAligned ? &depth_ring_ : nullptr, poses_,
-          cloud_ring_);
+          source == DepthSource::kAligned ? &depth_ring_ : nullptr,
+          source == DepthSource::kLidar ? &scan_ring_ : nullptr, poses_, cloud_ring_);
       log->info("perception: {}", perception_->describe());
     } catch (const std::exception& e) {
       log->error("perception disabled, running without a map: {}", e.what());
@@ -175,7 +178,7 @@ void Pipeline::stop() {
 }
 
 bool Pipeline::succeeded() const {
-  const bool mapped = !rig_->has_camera() || mapping_->stats().scans > 0;
+  const bool mapped = !(rig_->has_camera() || rig_->has_lidar()) || mapping_->stats().scans > 0;
   return (rig_->gives_poses() || estimation_->stats().initialised) && mapped;
 }
 
@@ -185,7 +188,7 @@ bool Pipeline::has_taken(const HandedOver& handed) const {
   if (!perception_) return true;
   const auto p = perception_->stats();
   const auto done = p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose;
-  return p.frames == handed.colour_frames && done == p.frames &&
+  return p.frames == handed.frames && done == p.frames &&
          mapping_->stats().scans + drops(cloud_ring_) == p.clouds;
 }
 
@@ -208,6 +211,7 @@ std::vector<std::pair<std::string, std::uint64_t>> Pipeline::ring_drops() const 
           {"gnss", drops(gnss_ring_)},
           {"colour", drops(colour_ring_)},
           {"depth", drops(depth_ring_)},
+          {"scans", drops(scan_ring_)},
           {"clouds", drops(cloud_ring_)}};
 }
 

@@ -5,6 +5,7 @@
 #include "semap/common/config.hpp"
 #include "semap/perception/dnn_segmenter.hpp"
 #include "semap/perception/geometry_segmenter.hpp"
+#include "semap/perception/label_image_segmenter.hpp"
 #include "semap/perception/model_card.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 #include "semap/perception/sim_classes.hpp"
@@ -34,6 +35,9 @@ std::unique_ptr<perception::Segmenter> make_segmenter(const SegmenterConfig& con
   if (config.kind == SegmenterConfig::Kind::kGeometry) {
     return std::make_unique<perception::GeometrySegmenter>(map_classes);
   }
+  if (config.kind == SegmenterConfig::Kind::kLabelImage) {
+    return std::make_unique<perception::LabelImageSegmenter>(map_classes);
+  }
   perception::PaletteOptions options;
   options.confidence = config.confidence;
   auto palette = config.palette.empty()
@@ -46,7 +50,7 @@ void check_segmenter_files(const SegmenterConfig& config, int map_classes) {
   if (config.kind == SegmenterConfig::Kind::kDnn) {
     load_card_for_map(config.model_card, map_classes);
   } else {
-    make_segmenter(config, map_classes);  // a palette is a small table; geometry has none
+    make_segmenter(config, map_classes);  // a palette is a small table; the others have none
   }
 }
 

@@ -82,4 +82,26 @@ common::LabeledCloud label_lidar_points(std::span<const Eigen::Vector3f> points_
   return cloud;
 }
 
+common::LabeledCloud occupied_lidar_points(std::span<const Eigen::Vector3f> points_lidar,
+                                           int num_classes,
+                                           const Eigen::Isometry3f& body_from_lidar,
+                                           const PointOptions& options, DropCounts& drops) {
+  if (num_classes < 2) throw std::invalid_argument("occupied_lidar_points: fewer than 2 classes");
+  common::LabeledCloud cloud;
+  cloud.origin = body_from_lidar.translation();
+  cloud.num_classes = static_cast<std::uint16_t>(num_classes);
+  cloud.points.reserve(points_lidar.size());
+  for (const Eigen::Vector3f& x : points_lidar) {
+    if (!x.allFinite()) {
+      ++drops.no_depth;
+    } else if (x.norm() > options.max_range) {
+      ++drops.out_of_range;
+    } else {
+      cloud.points.push_back(body_from_lidar * x);
+    }
+  }
+  cloud.labels.assign(cloud.points.size(), 1);
+  return cloud;
+}
+
 }  // namespace semap::perception

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <thread>
 
+#include "semap/perception/geometry_segmenter.hpp"
 #include "semap/perception/palette_segmenter.hpp"
 
 namespace semap::onboard {
@@ -91,7 +92,7 @@ class PerceptionStageTest : public ::testing::Test {
         camera_, depth_,
         std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(), kClasses,
                                                        options),
-        colour_, &depth_ring_, poses_, clouds_);
+        colour_, &depth_ring_, nullptr, poses_, clouds_);
   }
 
   void push_pair(double t, std::uint32_t sequence) {
@@ -197,7 +198,7 @@ TEST_F(PerceptionStageTest, PairsColourAndDepthByStampWithinTheTolerance) {
   // The 1.10 colour frame found no depth in time; the 1.15 depth frame was never used.
   EXPECT_EQ(s.unpaired, 1u);
   EXPECT_EQ(s.skipped, 0u);
-  EXPECT_EQ(s.depth_unused, 1u);
+  EXPECT_EQ(s.partner_unused, 1u);
   EXPECT_EQ(s.clouds, 1u);
 }
 
@@ -261,8 +262,95 @@ TEST_F(PerceptionStageTest, RefusesAlignedDepthWithoutADepthRing) {
   EXPECT_THROW(PerceptionStage(camera_, depth_,
                                std::make_unique<perception::PaletteSegmenter>(
                                    perception::cityscapes_palette(), kClasses),
-                               colour_, nullptr, poses_, clouds_),
+                               colour_, nullptr, nullptr, poses_, clouds_),
                std::invalid_argument);  // aligned depth without a depth ring
+}
+
+// LiDAR mode: a KITTI-like mount (camera looking along the LiDAR's x axis) with a 32x24 image.
+class LidarStageTest : public PerceptionStageTest {
+ protected:
+  LidarStageTest() {
+    depth_.source = DepthSource::kLidar;
+    auto& calib = depth_.lidar.camera;
+    calib.image_size = cv::Size(kWidth, kHeight);
+    calib.p_rect << 16, 0, 16, 0, 0, 16, 12, 0, 0, 0, 1, 0;
+    // LiDAR x forward, y left, z up -> camera x right, y down, z forward.
+    calib.cam_from_lidar.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+    depth_.lidar.body_from_lidar.translation() = Eigen::Vector3f(0.0f, 0.0f, 1.7f);
+  }
+
+  std::unique_ptr<PerceptionStage> make_lidar_stage(bool labels) {
+    std::unique_ptr<perception::Segmenter> segmenter;
+    if (labels) {
+      segmenter =
+          std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(), kClasses);
+    } else {
+      segmenter = std::make_unique<perception::GeometrySegmenter>(kClasses);
+    }
+    return std::make_unique<PerceptionStage>(camera_, depth_, std::move(segmenter), colour_,
+                                             nullptr, &scans_, poses_, clouds_);
+  }
+
+  // Two points ahead of the LiDAR (in the image's lower half: road) and two behind it.
+  static common::PointScan scan(double t, std::uint32_t sequence) {
+    common::PointScan s;
+    s.stamp = at(t);
+    s.sequence = sequence;
+    s.points = {{10.0f, 0.0f, -1.0f}, {8.0f, 1.0f, -1.0f}, {-10.0f, 0.0f, 0.0f}, {0.0f, 30.0f, 0.0f}};
+    return s;
+  }
+
+  SpscRing<common::PointScan> scans_{8, OverflowPolicy::kDropOldest};
+};
+
+TEST_F(LidarStageTest, LabelsScanPointsWithTheColourFrameNearestInTime) {
+  depth_.points.max_range = 20.0f;
+  depth_.points.soft_labels = false;
+  auto stage = make_lidar_stage(true);
+  poses_.append(drive(1.0, 2.0));
+  scans_.try_push(scan(1.10, 1));
+  colour_.try_push(colour_frame(1.16, 1));  // 60 ms off: no partner
+  stage->step();
+  EXPECT_TRUE(clouds_.empty());
+  scans_.try_push(scan(1.20, 2));
+  colour_.try_push(colour_frame(1.21, 2));
+  stage->step();
+  LabeledCloud cloud;
+  ASSERT_TRUE(clouds_.try_pop(cloud));
+  EXPECT_EQ(cloud.stamp, at(1.20));  // the scan's stamp
+  // The two points ahead, labelled road (class 1), placed with the body pose at 1.20 s.
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.labels, std::vector<std::uint16_t>(2, 1));
+  EXPECT_NEAR((cloud.points[0] - Eigen::Vector3f(2.4f + 10.0f, 0.0f, 0.7f)).norm(), 0.0f, 1e-4f);
+  EXPECT_NEAR((cloud.origin - Eigen::Vector3f(2.4f, 0.0f, 1.7f)).norm(), 0.0f, 1e-4f);
+  const auto s = stage->stats();
+  EXPECT_EQ(s.frames, 2u);  // scans
+  EXPECT_EQ(s.unpaired, 1u);
+  EXPECT_EQ(s.partner_unused, 1u);
+  EXPECT_EQ(s.dropped.out_of_image, 1u);  // behind the camera
+  EXPECT_EQ(s.dropped.out_of_range, 1u);  // 30 m away
+}
+
+TEST_F(LidarStageTest, MapsWholeScansWithoutLabels) {
+  depth_.points.max_range = 20.0f;
+  auto stage = make_lidar_stage(false);
+  poses_.append(drive(1.0, 2.0));
+  scans_.try_push(scan(1.5, 1));
+  stage->step();
+  LabeledCloud cloud;
+  ASSERT_TRUE(clouds_.try_pop(cloud));
+  // No image needed: every point within range, behind the camera too, as class 1.
+  ASSERT_EQ(cloud.size(), 3u);
+  EXPECT_EQ(cloud.labels, std::vector<std::uint16_t>(3, 1));
+  EXPECT_NEAR((cloud.points[2] - Eigen::Vector3f(3.0f - 10.0f, 0.0f, 1.7f)).norm(), 0.0f, 1e-4f);
+  EXPECT_EQ(stage->stats().dropped.out_of_range, 1u);
+  EXPECT_EQ(stage->stats().frames, 1u);
+}
+
+TEST_F(LidarStageTest, RefusesLidarWithoutAScanRing) {
+  EXPECT_THROW(PerceptionStage(camera_, depth_, std::make_unique<perception::GeometrySegmenter>(2),
+                               colour_, nullptr, nullptr, poses_, clouds_),
+               std::invalid_argument);
 }
 
 // The stage's own thread against a producer thread and the pose writer, as on the robot.

@@ -73,6 +73,13 @@ struct ImageFrame {
   std::vector<std::uint8_t> data;
 };
 
+// One LiDAR sweep as the sensor gives it: points in the LiDAR's own frame, metres.
+struct PointScan {
+  Stamp stamp;
+  std::uint32_t sequence = 0;
+  std::vector<Eigen::Vector3f> points;
+};
+
 // Labelled 3D points in the map frame. Exactly one of `labels` (hard labels) or
 // `probabilities` (num_classes floats per point, row-major) is filled.
 struct LabeledCloud {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "semap/onboard/sensor_rig.hpp"
+#include "semap/perception/datasets/kitti_odometry.hpp"
 #include "semap/perception/datasets/rgbd_sequence.hpp"
 
 namespace semap::onboard {
@@ -22,26 +23,42 @@ struct DatasetSelection {
   std::size_t stride = 1;
 };
 
-// Plays a recorded RGB-D dataset (TUM, Redwood: perception::datasets::RgbdSequence) through the
-// pipeline's own perception and mapping stages, as fast as they take it. For each frame the
-// dataset's pose goes into the pose history, then the depth image (raw units, Z16) and the
-// colour image into their rings, stamped with the time they are handed over; the next frame
-// waits until the stages have mapped this one or counted it as dropped with a reason (pace_by),
-// so a run maps every frame it can, and the same map every time. The body frame is the
-// configured camera mount's: a frame's body pose is its camera pose times optical-from-body.
-// A frame whose image cannot be read, or whose depth image is not 16-bit, is named and counted
-// (problems()) and skipped.
+// One frame of a dataset as the rig plays it: the files it reads and the body's pose.
+struct DatasetFrame {
+  std::filesystem::path colour;  // colour image (or label image); empty: none
+  std::filesystem::path depth;   // 16-bit depth PNG aligned with the colour image; empty: none
+  std::filesystem::path scan;    // Velodyne .bin scan; empty: none
+  Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+};
+
+// Plays a recorded dataset through the pipeline's own perception and mapping stages, as fast as
+// they take it: RGB-D frames (TUM, Redwood: perception::datasets::RgbdSequence) or LiDAR scans
+// with their images when there are any (KITTI odometry: KittiOdometrySequence). For each frame
+// the dataset's pose goes into the pose history, then the depth image (raw units, Z16), the scan
+// and the colour image into their rings, stamped with the time they are handed over; the next
+// frame waits until the stages have mapped this one or counted it as dropped with a reason
+// (pace_by), so a run maps every frame it can, and the same map every time. A frame whose file
+// cannot be read, or whose depth image is not 16-bit, is named and counted (problems()) and
+// skipped.
 class DatasetRig final : public SensorRig {
  public:
+  // RGB-D: the body frame is the configured camera mount's, a frame's body pose its camera pose
+  // times optical-from-body.
   DatasetRig(perception::datasets::RgbdSequence sequence, std::string name,
              const Eigen::Isometry3f& body_from_optical, DatasetSelection selection,
+             const SensorRings& rings);
+  // LiDAR: a frame's body pose is its LiDAR pose times lidar-from-body. Frames without an image
+  // hand over the scan alone (for a stage that maps whole scans).
+  DatasetRig(const perception::datasets::KittiOdometrySequence& sequence, std::string name,
+             const Eigen::Isometry3f& body_from_lidar, DatasetSelection selection,
              const SensorRings& rings);
   ~DatasetRig() override;
   DatasetRig(const DatasetRig&) = delete;
   DatasetRig& operator=(const DatasetRig&) = delete;
 
   std::string describe() const override;
-  bool has_camera() const override { return true; }
+  bool has_camera() const override { return has_colour_; }
+  bool has_lidar() const override { return has_scans_; }
   bool gives_poses() const override { return true; }
   // A dataset has no raw device streams to record: throws.
   void set_taps(RawTaps taps) override;
@@ -59,13 +76,18 @@ class DatasetRig final : public SensorRig {
   std::vector<perception::datasets::InputProblem> problems() const;
 
  private:
+  DatasetRig(std::vector<DatasetFrame> frames,
+             std::vector<perception::datasets::InputProblem> reader_problems, std::string name,
+             DatasetSelection selection, const SensorRings& rings);
   void run(std::stop_token stop);
-  bool hand_over(const perception::datasets::RgbdFrame& frame, std::uint32_t sequence);
+  bool hand_over(const DatasetFrame& frame, std::uint32_t sequence);
   void problem(const std::filesystem::path& file, const std::string& what);
 
-  perception::datasets::RgbdSequence sequence_;
+  std::vector<DatasetFrame> frames_;
+  std::size_t reader_problems_ = 0;
   std::string name_;
-  Eigen::Isometry3d optical_from_body_;
+  bool has_colour_ = false;
+  bool has_scans_ = false;
   std::vector<std::size_t> selected_;
   SensorRings rings_;
   RigDrivers drivers_;

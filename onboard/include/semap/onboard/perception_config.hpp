@@ -7,6 +7,7 @@
 #include "semap/drivers/camera_driver.hpp"
 #include "semap/perception/depth_projection.hpp"
 #include "semap/perception/labelled_points.hpp"
+#include "semap/perception/lidar_projection.hpp"
 #include "semap/perception/stereo_depth.hpp"
 
 namespace semap::onboard {
@@ -27,6 +28,17 @@ struct CameraConfig {
 enum class DepthSource {
   kAligned,  // a Z16 depth image aligned with the colour image, from a second device
   kStereo,   // the camera delivers a rectifiable stereo pair side by side in one frame
+  // LiDAR scans (SensorRings::scans), labelled by projecting them into the segmented colour
+  // image nearest in time; a segmenter without labels (geometry) maps whole scans, no image
+  // needed. Set by semap-dataset kitti-odometry: the robot has no LiDAR driver yet, so the
+  // YAML does not offer it.
+  kLidar,
+};
+
+// depth.lidar: where the LiDAR sits and how its points project into the colour image.
+struct LidarConfig {
+  perception::KittiCameraCalibration camera;  // P_rect, R_rect, cam_from_lidar, image size
+  Eigen::Isometry3f body_from_lidar = Eigen::Isometry3f::Identity();
 };
 
 // depth: where the labelled pixels get their range.
@@ -35,9 +47,11 @@ struct DepthConfig {
   // The depth device (aligned); on the simulated rig only the size and rate matter.
   drivers::CameraConfig driver;
   float depth_scale = 0.001f;                // metres per Z16 unit
-  double sync_tolerance_s = 0.02;            // colour and depth frames further apart do not pair
+  // Colour and depth frames (or scans) further apart do not pair.
+  double sync_tolerance_s = 0.02;
   std::filesystem::path stereo_calibration;  // OpenCV YAML or KITTI calib_cam_to_cam.txt
   perception::StereoOptions stereo;
+  LidarConfig lidar;
   perception::PointOptions points;  // stride, max_range, min_confidence, soft_labels
   std::size_t ring = 4;
 };
@@ -49,7 +63,8 @@ perception::StereoCalibration load_stereo_calibration(const std::filesystem::pat
 struct SegmenterConfig {
   // kDnn: a network OpenCV's DNN module reads (YAML `kind: dnn`, or `onnx`, its older name).
   // kGeometry: no labels, every depth pixel is map class 1 (geometry only).
-  enum class Kind { kDnn, kPalette, kGeometry } kind = Kind::kPalette;
+  // kLabelImage: the colour frames are label images of map class ids (semap-dataset --labels).
+  enum class Kind { kDnn, kPalette, kGeometry, kLabelImage } kind = Kind::kPalette;
   std::filesystem::path model_card;  // dnn
   // palette: YAML file; empty = the Cityscapes colours of the simulated world's classes
   std::filesystem::path palette;

@@ -23,12 +23,13 @@ class StereoDepth;
 namespace semap::onboard {
 
 struct PerceptionStageStats {
-  // Counted in colour frames: each frame taken becomes a cloud or one of the losses below.
-  std::uint64_t frames = 0;        // colour frames taken from the ring
+  // Counted in the frames that drive the stage, colour frames (LiDAR scans in LiDAR mode):
+  // each frame taken becomes a cloud or one of the losses below.
+  std::uint64_t frames = 0;        // frames taken from the ring
   std::uint64_t clouds = 0;        // posed clouds handed to the mapping stage
   std::uint64_t skipped = 0;       // passed over for a newer frame (the stage fell behind)
-  std::uint64_t unpaired = 0;      // no depth frame within the sync tolerance
-  std::uint64_t depth_unused = 0;  // depth frames no colour frame paired with
+  std::uint64_t unpaired = 0;      // no partner (depth frame, colour image) within tolerance
+  std::uint64_t partner_unused = 0;  // depth frames (LiDAR mode: colour frames) left unpaired
   std::uint64_t bad_frames = 0;    // undecodable, wrong format or wrong size
   std::uint64_t without_pose = 0;  // before the filter started, or older than its history
   std::uint64_t points = 0;        // labelled points handed on
@@ -38,9 +39,10 @@ struct PerceptionStageStats {
 };
 
 // Owns the camera's half of the pipeline on its own thread: takes colour frames (and depth
-// frames of a separate depth device) from the drivers' rings, pairs them by stamp, segments,
-// turns labelled pixels with depth into points in the body frame, poses them at the frame's
-// stamp from the estimation stage's history and hands the cloud to the mapping stage.
+// frames of a separate depth device, or LiDAR scans) from the drivers' rings, pairs them by
+// stamp, segments, turns labelled pixels with depth (or scan points projected into the
+// segmented image) into points in the body frame, poses them at the frame's stamp from the
+// estimation stage's history and hands the cloud to the mapping stage.
 // It keeps only the newest frame when it falls behind: drivers never wait for it.
 class PerceptionStage {
  public:
@@ -48,7 +50,8 @@ class PerceptionStage {
                   std::unique_ptr<perception::Segmenter> segmenter,
                   common::SpscRing<common::ImageFrame>& colour,
                   common::SpscRing<common::ImageFrame>* depth_frames,
-                  const SharedPoseHistory& poses, common::SpscRing<common::LabeledCloud>& clouds);
+                  common::SpscRing<common::PointScan>* scans, const SharedPoseHistory& poses,
+                  common::SpscRing<common::LabeledCloud>& clouds);
   ~PerceptionStage();
   PerceptionStage(const PerceptionStage&) = delete;
   PerceptionStage& operator=(const PerceptionStage&) = delete;
@@ -89,8 +92,13 @@ class PerceptionStage {
   bool take_frames();
   bool process_next();
   void process(const common::ImageFrame& colour, const common::ImageFrame* depth);
+  void process_scan(const common::PointScan& scan, const common::ImageFrame* colour);
+  cv::Mat colour_image(const common::ImageFrame& colour);
+  perception::Segmentation segment(const common::ImageFrame& colour, const cv::Mat& image);
+  void queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp,
+                      std::uint32_t sequence);
   bool pose_clouds();
-  void reject(const common::ImageFrame& frame, const std::string& why);
+  void reject(const std::string& frame, const std::string& why);
   void share_stats();
 
   CameraConfig camera_;
@@ -101,12 +109,16 @@ class PerceptionStage {
   std::unique_ptr<perception::StereoDepth> stereo_;
   common::SpscRing<common::ImageFrame>& colour_ring_;
   common::SpscRing<common::ImageFrame>* depth_ring_;
+  common::SpscRing<common::PointScan>* scan_ring_;
+  // LiDAR mode with a segmenter that labels nothing: whole scans, no colour image needed.
+  bool whole_scans_ = false;
   const SharedPoseHistory& poses_;
   common::SpscRing<common::LabeledCloud>& cloud_ring_;
   Eigen::Isometry3f body_from_optical_;
   drivers::JpegDecoder jpeg_;
   std::deque<common::ImageFrame> colour_pending_;
   std::deque<common::ImageFrame> depth_pending_;
+  std::deque<common::PointScan> scan_pending_;
   std::deque<BodyCloud> unposed_;
   LatencyWindow latency_;
   StageThread<PerceptionStageStats> stage_;  // last: joined before the members it uses

@@ -79,7 +79,8 @@ class Pipeline {
   // dropped; then the outputs publish the map's last changes.
   void stop();
 
-  // Whether frames are segmented and mapped (the rig has a camera and the segmenter loaded).
+  // Whether frames are segmented and mapped (the rig has a camera or a LiDAR and the segmenter
+  // loaded).
   bool perceiving() const { return perception_ != nullptr; }
   EstimationStageStats estimation() const { return estimation_->stats(); }
   std::optional<PerceptionStageStats> perception() const;
@@ -111,6 +112,7 @@ class Pipeline {
   common::SpscRing<common::GnssFix> gnss_ring_;
   common::SpscRing<common::ImageFrame> colour_ring_;
   common::SpscRing<common::ImageFrame> depth_ring_;
+  common::SpscRing<common::PointScan> scan_ring_;
   common::SpscRing<common::LabeledCloud> cloud_ring_;
   SharedPoseHistory poses_;
   std::unique_ptr<SensorRig> rig_;

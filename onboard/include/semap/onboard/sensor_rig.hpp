@@ -20,6 +20,7 @@ struct SensorRings {
   common::SpscRing<common::GnssFix>& gnss;
   common::SpscRing<common::ImageFrame>& colour;
   common::SpscRing<common::ImageFrame>& depth;
+  common::SpscRing<common::PointScan>& scans;
   SharedPoseHistory& poses;
 };
 
@@ -27,7 +28,8 @@ struct SensorRings {
 struct HandedOver {
   std::uint64_t imu_samples = 0;
   std::uint64_t gnss_fixes = 0;
-  std::uint64_t colour_frames = 0;
+  // The frames the perception stage is driven by: colour frames, or a LiDAR rig's scans.
+  std::uint64_t frames = 0;
 };
 
 // Where the robot's sensor streams come from: its devices (HardwareRig), a recording
@@ -41,6 +43,8 @@ class SensorRig {
   virtual std::string describe() const = 0;
   // Whether colour frames come (without them the robot localises and its map stays empty).
   virtual bool has_camera() const = 0;
+  // Whether LiDAR scans come (SensorRings::scans; set depth.source to kLidar).
+  virtual bool has_lidar() const { return false; }
   // Whether the rig gives the poses of its frames (SensorRings::poses) instead of the IMU and
   // GNSS streams the estimation stage turns into poses.
   virtual bool gives_poses() const { return false; }

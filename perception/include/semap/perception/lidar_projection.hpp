@@ -46,4 +46,12 @@ common::LabeledCloud label_lidar_points(std::span<const Eigen::Vector3f> points_
                                         const Eigen::Isometry3f& body_from_lidar,
                                         const PointOptions& options, DropCounts& drops);
 
+// A scan without labels (geometry only): every finite point within options.max_range of the
+// LiDAR becomes map class 1 ("something is there") of a `num_classes` map, in the body frame,
+// origin = the LiDAR centre; the others are counted as no_depth or out_of_range.
+common::LabeledCloud occupied_lidar_points(std::span<const Eigen::Vector3f> points_lidar,
+                                           int num_classes,
+                                           const Eigen::Isometry3f& body_from_lidar,
+                                           const PointOptions& options, DropCounts& drops);
+
 }  // namespace semap::perception
