@@ -23,14 +23,15 @@ std::vector<DatasetFrame> rgbd_frames(const perception::datasets::RgbdSequence& 
   return frames;
 }
 
-std::vector<DatasetFrame> lidar_frames(
-    const perception::datasets::KittiOdometrySequence& sequence,
-    const Eigen::Isometry3f& body_from_lidar) {
+std::vector<DatasetFrame> lidar_frames(const perception::datasets::KittiOdometrySequence& sequence,
+                                       const Eigen::Isometry3f& body_from_lidar) {
   const Eigen::Isometry3d lidar_from_body = body_from_lidar.cast<double>().inverse();
   std::vector<DatasetFrame> frames;
   frames.reserve(sequence.frames.size());
   for (const auto& f : sequence.frames) {
-    frames.push_back({f.image.value_or(std::filesystem::path{}), {}, f.scan,
+    frames.push_back({f.image.value_or(std::filesystem::path{}),
+                      {},
+                      f.scan,
                       f.world_from_lidar * lidar_from_body});
   }
   return frames;
@@ -97,8 +98,8 @@ void DatasetRig::summary(std::vector<std::string>& lines) const {
   }
   lines.push_back("dataset          : " + name_ + ", " + std::to_string(handed_over()) + " of " +
                   std::to_string(selected_.size()) + " selected frames handed over, " +
-                  std::to_string(unreadable) + " unreadable, " +
-                  std::to_string(reader_problems_) + " skipped by the reader");
+                  std::to_string(unreadable) + " unreadable, " + std::to_string(reader_problems_) +
+                  " skipped by the reader");
 }
 
 std::vector<perception::datasets::InputProblem> DatasetRig::problems() const {

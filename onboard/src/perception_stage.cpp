@@ -34,10 +34,9 @@ std::string scan_name(const common::PointScan& s) {
 // stream's newest minus the tolerance, and items beyond `capacity` (a stream that stopped
 // delivering must not let the other pile up).
 template <class Lead, class Partner, class Process>
-bool process_newest_pair(std::deque<Lead>& leads, std::deque<Partner>& partners,
-                         double tolerance, std::size_t lead_capacity,
-                         std::size_t partner_capacity, PerceptionStageStats& figures,
-                         Process&& process) {
+bool process_newest_pair(std::deque<Lead>& leads, std::deque<Partner>& partners, double tolerance,
+                         std::size_t lead_capacity, std::size_t partner_capacity,
+                         PerceptionStageStats& figures, Process&& process) {
   for (auto lead = leads.rbegin(); lead != leads.rend(); ++lead) {
     auto best = partners.end();
     double best_dt = tolerance;
@@ -229,12 +228,10 @@ bool PerceptionStage::process_next() {
     case DepthSource::kAligned:
       break;
   }
-  return process_newest_pair(
-      colour_pending_, depth_pending_, depth_.sync_tolerance_s, colour_ring_.capacity(),
-      depth_ring_->capacity(), figures,
-      [this](const common::ImageFrame& colour, const common::ImageFrame& depth) {
-        process(colour, &depth);
-      });
+  return process_newest_pair(colour_pending_, depth_pending_, depth_.sync_tolerance_s,
+                             colour_ring_.capacity(), depth_ring_->capacity(), figures,
+                             [this](const common::ImageFrame& colour,
+                                    const common::ImageFrame& depth) { process(colour, &depth); });
 }
 
 void PerceptionStage::reject(const std::string& frame, const std::string& why) {
@@ -295,10 +292,10 @@ void PerceptionStage::process(const common::ImageFrame& colour, const common::Im
       depth_m = perception::depth_metres(z16, depth_.depth_scale);
     }
     const perception::Segmentation segmentation = segment(colour, image);
-    queue_for_pose(perception::cloud_from_depth(depth_m, segmentation, intrinsics,
-                                                body_from_optical, depth_.points,
-                                                stage_.figures().dropped),
-                   colour.stamp, colour.sequence);
+    queue_for_pose(
+        perception::cloud_from_depth(depth_m, segmentation, intrinsics, body_from_optical,
+                                     depth_.points, stage_.figures().dropped),
+        colour.stamp, colour.sequence);
   } catch (const std::exception& e) {
     reject(frame_name(colour), e.what());
   }

@@ -207,12 +207,9 @@ Rings Pipeline::rings() const {
 }
 
 std::vector<std::pair<std::string, std::uint64_t>> Pipeline::ring_drops() const {
-  return {{"imu", drops(imu_ring_)},
-          {"gnss", drops(gnss_ring_)},
-          {"colour", drops(colour_ring_)},
-          {"depth", drops(depth_ring_)},
-          {"scans", drops(scan_ring_)},
-          {"clouds", drops(cloud_ring_)}};
+  return {{"imu", drops(imu_ring_)},       {"gnss", drops(gnss_ring_)},
+          {"colour", drops(colour_ring_)}, {"depth", drops(depth_ring_)},
+          {"scans", drops(scan_ring_)},    {"clouds", drops(cloud_ring_)}};
 }
 
 std::vector<std::string> Pipeline::summary() const {

@@ -6,8 +6,9 @@ namespace semap::perception {
 
 LabelImageSegmenter::LabelImageSegmenter(int num_classes) : num_classes_(num_classes) {
   if (num_classes < 2 || num_classes > 256) {
-    throw std::invalid_argument("LabelImageSegmenter: 8-bit label images hold 2..256 classes, not " +
-                                std::to_string(num_classes));
+    throw std::invalid_argument(
+        "LabelImageSegmenter: 8-bit label images hold 2..256 classes, not " +
+        std::to_string(num_classes));
   }
 }
 
@@ -27,8 +28,7 @@ Segmentation LabelImageSegmenter::segment(const cv::Mat& bgr) {
       if (id >= num_classes_) {
         throw std::invalid_argument("label image: pixel (" + std::to_string(u) + ", " +
                                     std::to_string(v) + ") = " + std::to_string(id) +
-                                    ", the map has classes 0.." +
-                                    std::to_string(num_classes_ - 1));
+                                    ", the map has classes 0.." + std::to_string(num_classes_ - 1));
       }
       out[u] = id == 0 ? kNoLabel : static_cast<std::uint16_t>(id);
     }

@@ -282,8 +282,8 @@ class LidarStageTest : public PerceptionStageTest {
   std::unique_ptr<PerceptionStage> make_lidar_stage(bool labels) {
     std::unique_ptr<perception::Segmenter> segmenter;
     if (labels) {
-      segmenter =
-          std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(), kClasses);
+      segmenter = std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(),
+                                                                 kClasses);
     } else {
       segmenter = std::make_unique<perception::GeometrySegmenter>(kClasses);
     }
@@ -296,7 +296,8 @@ class LidarStageTest : public PerceptionStageTest {
     common::PointScan s;
     s.stamp = at(t);
     s.sequence = sequence;
-    s.points = {{10.0f, 0.0f, -1.0f}, {8.0f, 1.0f, -1.0f}, {-10.0f, 0.0f, 0.0f}, {0.0f, 30.0f, 0.0f}};
+    s.points = {
+        {10.0f, 0.0f, -1.0f}, {8.0f, 1.0f, -1.0f}, {-10.0f, 0.0f, 0.0f}, {0.0f, 30.0f, 0.0f}};
     return s;
   }
 

@@ -46,7 +46,7 @@ struct DepthConfig {
   DepthSource source = DepthSource::kAligned;
   // The depth device (aligned); on the simulated rig only the size and rate matter.
   drivers::CameraConfig driver;
-  float depth_scale = 0.001f;                // metres per Z16 unit
+  float depth_scale = 0.001f;  // metres per Z16 unit
   // Colour and depth frames (or scans) further apart do not pair.
   double sync_tolerance_s = 0.02;
   std::filesystem::path stereo_calibration;  // OpenCV YAML or KITTI calib_cam_to_cam.txt

@@ -25,15 +25,15 @@ namespace semap::onboard {
 struct PerceptionStageStats {
   // Counted in the frames that drive the stage, colour frames (LiDAR scans in LiDAR mode):
   // each frame taken becomes a cloud or one of the losses below.
-  std::uint64_t frames = 0;        // frames taken from the ring
-  std::uint64_t clouds = 0;        // posed clouds handed to the mapping stage
-  std::uint64_t skipped = 0;       // passed over for a newer frame (the stage fell behind)
-  std::uint64_t unpaired = 0;      // no partner (depth frame, colour image) within tolerance
+  std::uint64_t frames = 0;          // frames taken from the ring
+  std::uint64_t clouds = 0;          // posed clouds handed to the mapping stage
+  std::uint64_t skipped = 0;         // passed over for a newer frame (the stage fell behind)
+  std::uint64_t unpaired = 0;        // no partner (depth frame, colour image) within tolerance
   std::uint64_t partner_unused = 0;  // depth frames (LiDAR mode: colour frames) left unpaired
-  std::uint64_t bad_frames = 0;    // undecodable, wrong format or wrong size
-  std::uint64_t without_pose = 0;  // before the filter started, or older than its history
-  std::uint64_t points = 0;        // labelled points handed on
-  perception::DropCounts dropped;  // pixels dropped on the way to points, by reason
+  std::uint64_t bad_frames = 0;      // undecodable, wrong format or wrong size
+  std::uint64_t without_pose = 0;    // before the filter started, or older than its history
+  std::uint64_t points = 0;          // labelled points handed on
+  perception::DropCounts dropped;    // pixels dropped on the way to points, by reason
   double segment_seconds_total = 0.0;
   double segment_seconds_max = 0.0;
 };
@@ -95,8 +95,7 @@ class PerceptionStage {
   void process_scan(const common::PointScan& scan, const common::ImageFrame* colour);
   cv::Mat colour_image(const common::ImageFrame& colour);
   perception::Segmentation segment(const common::ImageFrame& colour, const cv::Mat& image);
-  void queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp,
-                      std::uint32_t sequence);
+  void queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp, std::uint32_t sequence);
   bool pose_clouds();
   void reject(const std::string& frame, const std::string& why);
   void share_stats();
