@@ -131,6 +131,11 @@ void DatasetRig::run(std::stop_token stop) {
 }
 
 bool DatasetRig::hand_over(const DatasetFrame& frame, std::uint32_t sequence) {
+  // Scans are labelled with their image; a scan without one would wait for it forever.
+  if (has_colour_ && !frame.scan.empty() && frame.colour.empty()) {
+    problem(frame.scan, "no image to label the scan with");
+    return false;
+  }
   cv::Mat colour;
   if (!frame.colour.empty()) {
     colour = cv::imread(frame.colour.string(), cv::IMREAD_COLOR);
