@@ -21,10 +21,11 @@
 #include "semap/estimation/pose_history.hpp"
 #include "semap/estimation/so3.hpp"
 #include "semap/map_io/map_export.hpp"
-#include "semap/map_io/semantic_kitti_io.hpp"
 #include "semap/mapping/cloud_transform.hpp"
 #include "semap/mapping/semantic_map.hpp"
 #include "semap/mapping/smap_io.hpp"
+#include "semap/perception/datasets/dataset.hpp"
+#include "semap/perception/datasets/velodyne_bin.hpp"
 #include "semap/perception/kitti_calib_text.hpp"
 #include "semap/perception/lidar_projection.hpp"
 #include "top_view.hpp"
@@ -137,7 +138,8 @@ ScanStats map_scans(const KittiRawDrive& drive, std::size_t first, std::size_t l
       ++stats.without_pose;
       continue;
     }
-    const std::vector<Eigen::Vector4f> raw = map_io::read_kitti_scan(drive.scans[i]);
+    const std::vector<Eigen::Vector4f> raw =
+        perception::datasets::read_velodyne_bin(drive.scans[i]);
     std::vector<Eigen::Vector3f> points(raw.size());
     for (std::size_t k = 0; k < raw.size(); ++k) points[k] = raw[k].head<3>();
     auto start = std::chrono::steady_clock::now();
@@ -289,7 +291,7 @@ int run(const CLI::App& command, const RawOptions& o) {
 bool is_bad_input(const std::exception& e) {
   return dynamic_cast<const DriveError*>(&e) != nullptr ||
          dynamic_cast<const perception::CalibrationError*>(&e) != nullptr ||
-         dynamic_cast<const map_io::KittiError*>(&e) != nullptr ||
+         dynamic_cast<const perception::datasets::DatasetError*>(&e) != nullptr ||
          dynamic_cast<const common::ConfigError*>(&e) != nullptr;  // model card
 }
 
