@@ -13,6 +13,8 @@
 #include <thread>
 
 #include "dataset_report.hpp"
+#include "kitti_raw_command.hpp"
+#include "kitti_semantic_command.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/perception/datasets/redwood.hpp"
@@ -176,7 +178,11 @@ int main(int argc, char** argv) {
       "redwood", "Redwood / Open3D: color/, depth/, odometry.log, intrinsic JSON");
   add_common(tum);
   add_common(redwood);
+  apps::add_kitti_raw_command(app);
+  apps::add_kitti_semantic_command(app);
   CLI11_PARSE(app, argc, argv);
+  // kitti-raw and semantickitti run as the parse's callbacks (a failure exits with its status).
+  if (app.got_subcommand("kitti-raw") || app.got_subcommand("semantickitti")) return 0;
   if (o.segmenter_card.empty() && !o.no_labels) {
     std::cerr << "semap-dataset: give --segmenter CARD or --no-labels\n";
     return 2;
