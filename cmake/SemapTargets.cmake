@@ -56,7 +56,7 @@ endfunction()
 # linked by the offline tools only, never by semap-onboard.
 set(SEMAP_LIBRARIES common firmware_bridge drivers estimation perception mapping map_io dds_idl onboard sim)
 # Library folders that a narrow SEMAP_ONLY list must not include without another one.
-set(semap_map_io_needs mapping)
+set(semap_map_io_needs mapping perception)
 set(semap_onboard_needs drivers estimation perception mapping dds_idl)
 set(semap_sim_needs firmware_bridge estimation perception)
 # Links a library must never make, though the order above would allow them: the robot's

@@ -4,6 +4,8 @@
 //   semap-dataset tum DIR --segmenter models/semap-seg.yaml --intrinsics 535.4,539.2,320.1,247.6
 //   semap-dataset redwood DIR --no-labels --out out/redwood
 //   semap-dataset kitti-odometry sequences/00 --calib calib.txt --no-labels
+//   semap-dataset kitti-raw / semantickitti: KITTI raw drives (their own filter on OXTS) and
+//   SemanticKITTI evaluation, kitti_raw_command.hpp and kitti_semantic_command.hpp.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -16,6 +18,8 @@
 #include <thread>
 
 #include "dataset_report.hpp"
+#include "kitti_raw_command.hpp"
+#include "kitti_semantic_command.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/perception/datasets/kitti_odometry.hpp"
@@ -280,7 +284,11 @@ int main(int argc, char** argv) {
   kitti->add_option("--poses", o.poses,
                     "camera-0 poses (default: DIR/poses.txt, else DIR/../../poses/<name>.txt)");
   kitti->add_option("--calib", o.calib, "calib.txt with P2 and Tr (default: DIR/calib.txt)");
+  apps::add_kitti_raw_command(app);
+  apps::add_kitti_semantic_command(app);
   CLI11_PARSE(app, argc, argv);
+  // kitti-raw and semantickitti run as the parse's callbacks (a failure exits with its status).
+  if (app.got_subcommand("kitti-raw") || app.got_subcommand("semantickitti")) return 0;
   if (o.segmenter_card.empty() && o.labels_dir.empty() && !o.no_labels) {
     std::cerr << "semap-dataset: give --segmenter CARD, --labels DIR or --no-labels\n";
     return 2;

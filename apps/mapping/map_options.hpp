@@ -1,7 +1,7 @@
 #pragma once
 
-// Map flags shared by semap-map and semap-map-eval: a YAML `map:` section first, then the
-// flags given on the command line override it.
+// Map flags shared by semap-map, semap-map-eval and semap-dataset kitti-raw / semantickitti:
+// a YAML `map:` section first, then the flags given on the command line override it.
 #include <CLI/CLI.hpp>
 #include <string>
 

@@ -1,8 +1,9 @@
 #pragma once
 
-// A simulated drive written in the KITTI raw layout, for semap-kitti raw's tests and figures:
-// the estimation simulator's car drives through the perception simulator's street, and the
-// drive is stored as an OXTS unit, a Velodyne and a labelled left colour camera would store it.
+// A simulated drive written in the KITTI raw layout, for semap-dataset kitti-raw's tests and
+// figures: the estimation simulator's car drives through the perception simulator's street,
+// and the drive is stored as an OXTS unit, a Velodyne and a labelled left colour camera would
+// store it.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>

@@ -1,5 +1,5 @@
 // write_kitti_raw_drive: a simulated drive in the KITTI raw layout (OXTS, Velodyne, label
-// images, calibration), for running semap-kitti raw without the dataset (docs/kitti.md).
+// images, calibration), for running semap-dataset kitti-raw without the dataset (docs/kitti.md).
 #include <cstdio>
 #include <cstdlib>
 #include <exception>

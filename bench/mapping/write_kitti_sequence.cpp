@@ -1,5 +1,5 @@
 // Writes the synthetic 64-beam street of map_bench as a SemanticKITTI sequence, to time and
-// score `semap-kitti semantic` on scans of SemanticKITTI's size (about 120k points, 20
+// score `semap-dataset semantickitti` on scans of SemanticKITTI's size (about 120k points, 20
 // classes): velodyne/NNNNNN.bin (sensor frame), labels/NNNNNN.label (raw ids), poses.txt
 // (camera poses) and calib.txt (Tr: the dataset's velodyne-to-camera axis swap).
 //   write_kitti_sequence OUT_DIR [SCANS=300]

@@ -7,6 +7,9 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "semap/perception/datasets/dataset.hpp"
+#include "semap/perception/datasets/velodyne_bin.hpp"
+
 namespace semap::map_io {
 
 namespace {
@@ -70,19 +73,6 @@ const std::array<const char*, kKittiClasses>& kitti_class_names() {
       "bicyclist", "motorcyclist", "road",    "parking",    "sidewalk", "other-ground",  "building",
       "fence",     "vegetation",   "trunk",   "terrain",    "pole",     "traffic-sign"};
   return kNames;
-}
-
-std::vector<Eigen::Vector4f> read_kitti_scan(const std::filesystem::path& path) {
-  const std::string bytes = read_bytes(path);
-  if (bytes.size() % (4 * sizeof(float)) != 0) {
-    throw KittiError(path.string() + ": size " + std::to_string(bytes.size()) +
-                     " is not a multiple of 16 bytes (x y z remission)");
-  }
-  std::vector<Eigen::Vector4f> points(bytes.size() / (4 * sizeof(float)));
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    std::memcpy(points[i].data(), bytes.data() + i * 16, 16);
-  }
-  return points;
 }
 
 std::vector<std::uint32_t> read_kitti_labels(const std::filesystem::path& path) {
@@ -181,7 +171,12 @@ common::LabeledCloud KittiSequence::scan(std::size_t index) const {
   }
   const auto scan_path = folder_ / "velodyne" / kitti_frame_name(index, ".bin");
   const auto label_path = folder_ / "labels" / kitti_frame_name(index, ".label");
-  const auto points = read_kitti_scan(scan_path);
+  std::vector<Eigen::Vector4f> points;
+  try {
+    points = perception::datasets::read_velodyne_bin(scan_path);
+  } catch (const perception::datasets::DatasetError& e) {
+    throw KittiError(e.what());  // names the file
+  }
   const auto labels = read_kitti_labels(label_path);
   if (labels.size() != points.size()) {
     throw KittiError(label_path.string() + ": " + std::to_string(labels.size()) + " labels for " +

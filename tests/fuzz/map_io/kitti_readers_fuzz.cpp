@@ -1,8 +1,9 @@
-// The SemanticKITTI readers on any bytes as a file: the first byte picks velodyne .bin,
-// .label, poses.txt or calib.txt, the rest is the file (written to a per-process temporary).
-// A reader returns what the bytes hold (.bin: size / 16 points equal to the bytes, .label:
-// size / 4 labels, poses and Tr: finite 3x4 matrices with the row 0 0 0 1) or throws KittiError
-// whose message starts with the file's path (and, for text files, names the line).
+// The SemanticKITTI readers on any bytes as a file: the first byte picks velodyne .bin
+// (perception's read_velodyne_bin, which map_io's KittiSequence reads scans with), .label,
+// poses.txt or calib.txt, the rest is the file (written to a per-process temporary). A reader
+// returns what the bytes hold (.bin: size / 16 points equal to the bytes, .label: size / 4
+// labels, poses and Tr: finite 3x4 matrices with the row 0 0 0 1) or throws KittiError (.bin:
+// DatasetError) whose message starts with the file's path (and, for text files, names the line).
 #include <unistd.h>
 
 #include <cmath>
@@ -16,6 +17,8 @@
 
 #include "fuzz_input.hpp"
 #include "semap/map_io/semantic_kitti_io.hpp"
+#include "semap/perception/datasets/dataset.hpp"
+#include "semap/perception/datasets/velodyne_bin.hpp"
 
 namespace {
 
@@ -47,7 +50,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     switch (kind) {
       case 0: {
-        const auto points = mi::read_kitti_scan(path);
+        const auto points = semap::perception::datasets::read_velodyne_bin(path);
         if (points.size() * 16 != bytes.size()) std::abort();
         for (std::size_t i = 0; i < points.size(); ++i) {
           if (std::memcmp(points[i].data(), bytes.data() + i * 16, 16) != 0) std::abort();
@@ -76,6 +79,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   } catch (const mi::KittiError& e) {
     if (std::string(e.what()).rfind(path.string() + ":", 0) != 0) std::abort();
+  } catch (const semap::perception::datasets::DatasetError& e) {
+    if (kind != 0 || std::string(e.what()).rfind(path.string() + ":", 0) != 0) std::abort();
   }
   return 0;
 }

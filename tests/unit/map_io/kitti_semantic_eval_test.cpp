@@ -107,7 +107,8 @@ TEST_F(IsolatedPoints, BadScansAreSkippedCountedAndNamed) {
   const KittiSemanticResult r = evaluate_kitti_semantic(files_.dir(), config_);
   EXPECT_EQ(r.scans, 1u);
   ASSERT_EQ(r.bad_scans.size(), 3u);
-  EXPECT_NE(r.bad_scans[0].find("000001.bin: size 17 is not a multiple of 16"), std::string::npos)
+  EXPECT_NE(r.bad_scans[0].find("000001.bin: size 17 bytes is not a multiple of 16"),
+            std::string::npos)
       << r.bad_scans[0];
   EXPECT_NE(r.bad_scans[1].find("labels/000002.label: 1 labels for 2 points"), std::string::npos)
       << r.bad_scans[1];

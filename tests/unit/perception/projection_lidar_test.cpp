@@ -167,9 +167,9 @@ TEST(KittiCameraCalibration, LoadsRealFiles) {
       std::invalid_argument);
 }
 
-// More points through the real 2011_09_26 calibration (semap-kitti raw's projection). Pixels
-// worked out apart from this code: P_rect_02 * R_rect_00 * [R T] of the files, multiplied out
-// in plain Python. (6, 3, -1.7) lands below the image (v = 389.9 > 375), (-5, 0, 0) behind it.
+// More points through the real 2011_09_26 calibration (semap-dataset kitti-raw's projection).
+// Pixels worked out apart from this code: P_rect_02 * R_rect_00 * [R T] of the files, multiplied
+// out in plain Python. (6, 3, -1.7) lands below the image (v = 389.9 > 375), (-5, 0, 0) behind it.
 TEST(KittiCameraCalibration, RealCalibrationPixels) {
   const auto dir = std::filesystem::path(SEMAP_SHARED_DATA_DIR) / "kitti/2011_09_26";
   const auto calib =

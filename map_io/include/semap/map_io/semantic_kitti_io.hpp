@@ -34,8 +34,7 @@ const std::array<const char*, kKittiClasses>& kitti_class_names();
 // The dataset's file name of scan `index`: six digits and `extension` (".bin", ".label").
 std::string kitti_frame_name(std::size_t index, std::string_view extension);
 
-// velodyne/NNNNNN.bin: float32 x, y, z, remission per point.
-std::vector<Eigen::Vector4f> read_kitti_scan(const std::filesystem::path& path);
+// velodyne/NNNNNN.bin: perception::datasets::read_velodyne_bin (KITTI odometry's reader).
 // labels/NNNNNN.label: uint32 per point, semantic id in the lower 16 bits (returned raw).
 std::vector<std::uint32_t> read_kitti_labels(const std::filesystem::path& path);
 // poses.txt: 12 numbers (row-major 3x4) per line, the left camera pose of each scan.
@@ -59,7 +58,8 @@ class KittiSequence {
 
   std::size_t size() const { return poses_.size(); }
   // Scan `index` in the world frame of the first camera pose, labels through the learning
-  // map, origin = the LiDAR position. Throws KittiError if files are missing or disagree.
+  // map, origin = the LiDAR position. Throws KittiError if files are missing or disagree
+  // (for the scan itself, read_velodyne_bin's message).
   common::LabeledCloud scan(std::size_t index) const;
   // LiDAR pose in the world: T_world_cam * T_cam_velo.
   Eigen::Isometry3d lidar_pose(std::size_t index) const;

@@ -1,4 +1,5 @@
-// Runs build/bin/semap-kitti as a user would: its table, figures, errors and exit codes.
+// Runs build/bin/semap-dataset semantickitti as a user would: its table, figures, errors and exit
+// codes.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -14,13 +15,13 @@ namespace {
 using test_support::CliResult;
 using testing::KittiTestSequence;
 
-CliResult run(const std::string& args) { return test_support::run_cli(SEMAP_KITTI_EXE, args); }
+CliResult run(const std::string& args) { return test_support::run_cli(SEMAP_DATASET_EXE, args); }
 
 bool has(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-class SemapKittiCli : public ::testing::Test {
+class SemanticKittiCli : public ::testing::Test {
  protected:
   void SetUp() override {
     files_.write_poses({Eigen::Vector3d::Zero(), {0.2, 0, 0}});
@@ -30,11 +31,11 @@ class SemapKittiCli : public ::testing::Test {
       files_.write_scan(s, testing::isolated_points(labels.size()), labels);
     }
   }
-  std::string sequence() const { return "semantic --sequence " + files_.dir().string(); }
+  std::string sequence() const { return "semantickitti --sequence " + files_.dir().string(); }
   KittiTestSequence files_;
 };
 
-TEST_F(SemapKittiCli, PrintsTheTableTimingAndMemory) {
+TEST_F(SemanticKittiCli, PrintsTheTableTimingAndMemory) {
   const CliResult r = run(sequence() + " --threads 2 --flip 0 --progress-seconds 0.000001");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(has(r.out, "threads 2")) << r.out;
@@ -46,7 +47,7 @@ TEST_F(SemapKittiCli, PrintsTheTableTimingAndMemory) {
   EXPECT_TRUE(has(r.out, "insert_ms S-BKI median")) << r.out;
   EXPECT_TRUE(has(r.out, "peak_memory_mib")) << r.out;
   EXPECT_TRUE(has(r.out, "scans 2 points 6")) << r.out;
-  EXPECT_TRUE(has(r.out, "semap-kitti semantic: 2/2 scans")) << r.out;
+  EXPECT_TRUE(has(r.out, "semap-dataset semantickitti: 2/2 scans")) << r.out;
   EXPECT_TRUE(has(r.out, "ETA 0 s")) << r.out;
   const CliResult bki = run(sequence() + " --method bki --first 1 --ell 0.2");
   ASSERT_EQ(bki.status, 0) << bki.out;
@@ -56,7 +57,7 @@ TEST_F(SemapKittiCli, PrintsTheTableTimingAndMemory) {
   EXPECT_FALSE(has(bki.out, "ETA")) << bki.out;  // no progress line within 5 s
 }
 
-TEST_F(SemapKittiCli, BadInputNamesTheFileAndSetsTheExitStatus) {
+TEST_F(SemanticKittiCli, BadInputNamesTheFileAndSetsTheExitStatus) {
   files_.write_bytes("velodyne/000001.bin", "0123456789", 10);
   const CliResult skipped = run(sequence());
   EXPECT_EQ(skipped.status, 2) << skipped.out;

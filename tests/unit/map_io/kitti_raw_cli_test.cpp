@@ -1,4 +1,4 @@
-// Runs build/bin/semap-kitti raw on simulated drives written in the KITTI raw layout: the
+// Runs build/bin/semap-dataset kitti-raw on simulated drives written in the KITTI raw layout: the
 // filter beats its GNSS, the map holds the street's classes where the street has them, and bad
 // input is named with exit status 2.
 #include <gtest/gtest.h>
@@ -24,7 +24,7 @@ using test_support::CliResult;
 
 const fs::path kKittiCalib = fs::path(SEMAP_SHARED_DATA_DIR) / "kitti/2011_09_26";
 
-CliResult run(const std::string& args) { return test_support::run_cli(SEMAP_KITTI_EXE, args); }
+CliResult run(const std::string& args) { return test_support::run_cli(SEMAP_DATASET_EXE, args); }
 
 bool has(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
@@ -38,19 +38,19 @@ double figure(const std::string& out, const std::string& key) {
 }
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("semap_kitti_raw_" + name + "_" + std::to_string(getpid()));
+  const fs::path dir = fs::temp_directory_path() /
+                       ("semap_dataset_kitti_raw_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
 }
 
 std::string args_for(const bench::SimKittiRawDrive& d, const fs::path& out) {
-  return "raw --drive " + d.drive_dir.string() + " --labels " + d.labels_dir.string() +
+  return "kitti-raw --drive " + d.drive_dir.string() + " --labels " + d.labels_dir.string() +
          " --num-classes 8 --out " + out.string();
 }
 
-class SemapKittiRawDrive : public ::testing::Test {
+class KittiRawCliDrive : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     root_ = new fs::path(temp_dir("drive"));
@@ -67,10 +67,10 @@ class SemapKittiRawDrive : public ::testing::Test {
   static fs::path* root_;
   static bench::SimKittiRawDrive* drive_;
 };
-fs::path* SemapKittiRawDrive::root_ = nullptr;
-bench::SimKittiRawDrive* SemapKittiRawDrive::drive_ = nullptr;
+fs::path* KittiRawCliDrive::root_ = nullptr;
+bench::SimKittiRawDrive* KittiRawCliDrive::drive_ = nullptr;
 
-TEST_F(SemapKittiRawDrive, FilterBeatsGnssAndTheMapHoldsTheStreet) {
+TEST_F(KittiRawCliDrive, FilterBeatsGnssAndTheMapHoldsTheStreet) {
   const fs::path out = *root_ / "out";
   const CliResult r =
       run(args_for(*drive_, out) +
@@ -84,7 +84,7 @@ TEST_F(SemapKittiRawDrive, FilterBeatsGnssAndTheMapHoldsTheStreet) {
   EXPECT_LT(figure(r.out, "InEKF ATE "), 0.5 * gnss) << r.out;
   EXPECT_LT(figure(r.out, "ESKF  ATE "), 0.5 * gnss) << r.out;
   EXPECT_LT(figure(r.out, "heading_rmse "), 2.0) << r.out;
-  EXPECT_TRUE(has(r.out, "semap-kitti raw: ")) << r.out;  // the progress line
+  EXPECT_TRUE(has(r.out, "semap-dataset kitti-raw: ")) << r.out;  // the progress line
   EXPECT_TRUE(has(r.out, "label_ms (segmentation + projection) median")) << r.out;
   EXPECT_TRUE(has(r.out, "insert_ms median")) << r.out;
   EXPECT_GT(figure(r.out, "out_of_image "), 0.0) << r.out;  // the points behind the camera
@@ -123,7 +123,7 @@ TEST_F(SemapKittiRawDrive, FilterBeatsGnssAndTheMapHoldsTheStreet) {
   EXPECT_GT(below[1], below[3] + below[4] + below[5]) << below[1];
 }
 
-TEST_F(SemapKittiRawDrive, ScanRangeAndPacketNoise) {
+TEST_F(KittiRawCliDrive, ScanRangeAndPacketNoise) {
   const CliResult r = run(args_for(*drive_, *root_ / "out_range") +
                           " --gnss-sigma packet --first 40 --last 59 --threads 1");
   ASSERT_EQ(r.status, 0) << r.out;
@@ -134,7 +134,7 @@ TEST_F(SemapKittiRawDrive, ScanRangeAndPacketNoise) {
 
 // The shipped network (trained on the simulated camera) segments image_02; its probabilities
 // go into the map as soft labels, and the ground below the car comes out as road.
-TEST(SemapKittiRawSegmenter, ModelCardLabelsTheCameraImages) {
+TEST(KittiRawCliSegmenter, ModelCardLabelsTheCameraImages) {
   const fs::path root = temp_dir("segmenter");
   bench::SimKittiRawOptions o;
   o.duration_s = 6.0;
@@ -143,7 +143,7 @@ TEST(SemapKittiRawSegmenter, ModelCardLabelsTheCameraImages) {
   o.colour_images = true;
   const auto drive = bench::write_sim_kitti_raw_drive(root, kKittiCalib, o);
   const fs::path card = fs::path(SEMAP_SOURCE_DIR) / "models/semap-seg.yaml";
-  const CliResult r = run("raw --drive " + drive.drive_dir.string() + " --segmenter " +
+  const CliResult r = run("kitti-raw --drive " + drive.drive_dir.string() + " --segmenter " +
                           card.string() + " --out " + (root / "out").string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(has(r.out, "dnn segmenter: ")) << r.out;
@@ -156,7 +156,7 @@ TEST(SemapKittiRawSegmenter, ModelCardLabelsTheCameraImages) {
   }
   EXPECT_GT(below[1], below[3] + below[4] + below[5]) << below[1];
   fs::remove(drive.image_dir / "0000000020.png");
-  const CliResult missing = run("raw --drive " + drive.drive_dir.string() + " --segmenter " +
+  const CliResult missing = run("kitti-raw --drive " + drive.drive_dir.string() + " --segmenter " +
                                 card.string() + " --out " + (root / "out").string());
   EXPECT_EQ(missing.status, 2) << missing.out;
   EXPECT_TRUE(has(missing.out, "image_02/data/0000000020.png: missing image")) << missing.out;
@@ -164,7 +164,7 @@ TEST(SemapKittiRawSegmenter, ModelCardLabelsTheCameraImages) {
 }
 
 // A small drive of its own per case, broken in one way.
-class SemapKittiRawBadInput : public ::testing::Test {
+class KittiRawCliBadInput : public ::testing::Test {
  protected:
   void SetUp() override {
     root_ = temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -184,38 +184,38 @@ class SemapKittiRawBadInput : public ::testing::Test {
   bench::SimKittiRawDrive drive_;
 };
 
-TEST_F(SemapKittiRawBadInput, RunsWhenIntact) {
+TEST_F(KittiRawCliBadInput, RunsWhenIntact) {
   const CliResult r = run(args_for(drive_, root_ / "out"));
   EXPECT_EQ(r.status, 0) << r.out;
 }
 
-TEST_F(SemapKittiRawBadInput, MissingCalibrationKey) {
+TEST_F(KittiRawCliBadInput, MissingCalibrationKey) {
   std::ofstream(drive_.calib_dir / "calib_velo_to_cam.txt") << "R: 1 0 0 0 1 0 0 0 1\n";
   expect_error("calib_velo_to_cam.txt");
   expect_error("'T'");
 }
 
-TEST_F(SemapKittiRawBadInput, ScanSizeNotAMultipleOf16) {
+TEST_F(KittiRawCliBadInput, ScanSizeNotAMultipleOf16) {
   const fs::path bin = drive_.drive_dir / "velodyne_points/data/0000000030.bin";
   fs::resize_file(bin, fs::file_size(bin) - 4);
   expect_error("0000000030.bin: size");
   expect_error("not a multiple of 16");
 }
 
-TEST_F(SemapKittiRawBadInput, MissingLabelImage) {
+TEST_F(KittiRawCliBadInput, MissingLabelImage) {
   fs::remove(drive_.labels_dir / "0000000031.png");
   expect_error("0000000031.png: missing image");
 }
 
-TEST_F(SemapKittiRawBadInput, UnreadableOxts) {
+TEST_F(KittiRawCliBadInput, UnreadableOxts) {
   std::ofstream(drive_.drive_dir / "oxts/data/0000000005.txt") << "49.0 8.4 oops\n";
   expect_error("0000000005.txt:1");
   fs::remove_all(drive_.drive_dir / "oxts");
   expect_error("oxts/timestamps.txt: cannot open");
 }
 
-TEST_F(SemapKittiRawBadInput, NeitherSegmenterNorLabels) {
-  const CliResult r = run("raw --drive " + drive_.drive_dir.string());
+TEST_F(KittiRawCliBadInput, NeitherSegmenterNorLabels) {
+  const CliResult r = run("kitti-raw --drive " + drive_.drive_dir.string());
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_TRUE(has(r.out, "--segmenter or --labels")) << r.out;
 }

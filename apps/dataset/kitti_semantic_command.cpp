@@ -12,6 +12,7 @@
 #include "map_options.hpp"
 #include "progress_meter.hpp"
 #include "scan_timing.hpp"
+#include "semap/common/logging.hpp"
 #include "semap/common/process_usage.hpp"
 #include "semap/map_io/kitti_iou_table.hpp"
 #include "semap/map_io/kitti_semantic_eval.hpp"
@@ -99,18 +100,18 @@ int run(const CLI::App& command, const SemanticOptions& o) {
     }
     print_settings(o, config,
                    tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-    ProgressMeter meter("semap-kitti semantic", o.progress_seconds);
+    ProgressMeter meter("semap-dataset semantickitti", o.progress_seconds);
     const map_io::KittiSemanticResult result = map_io::evaluate_kitti_semantic(
         o.sequence, config,
         [&](std::size_t done, std::size_t total) { meter.update(done, total); });
     print_result(result, meter.elapsed_seconds());
     for (const std::string& message : result.bad_scans) {
-      std::fprintf(stderr, "semap-kitti semantic: skipped %s\n", message.c_str());
+      std::fprintf(stderr, "semap-dataset semantickitti: skipped %s\n", message.c_str());
     }
     // The table covers the scans that could be read; a skipped scan still fails the run.
     return result.bad_scans.empty() ? 0 : 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "semap-kitti semantic: %s\n", e.what());
+    std::fprintf(stderr, "semap-dataset semantickitti: %s\n", e.what());
     return 1;
   }
 }
@@ -121,7 +122,7 @@ void add_kitti_semantic_command(CLI::App& app) {
   auto options = std::make_shared<SemanticOptions>();
   SemanticOptions& o = *options;
   CLI::App* command = app.add_subcommand(
-      "semantic",
+      "semantickitti",
       "Build S-CSM and S-BKI maps from a sequence's predicted (or noisy ground-truth) labels, "
       "query them at every point and print the IoU table of Gan et al.'s Table IV. Map "
       "defaults: resolution 0.1, block depth 3, sf2 0.1, ell 0.3, prior 0.001, free-res 100, "
@@ -144,6 +145,7 @@ void add_kitti_semantic_command(CLI::App& app) {
                       "progress line on stderr every so many seconds (0: none)");
   add_map_parameter_options(*command, o.map);
   command->callback([command, options] {
+    common::setup_logging("warn");
     const int status = run(*command, *options);
     if (status != 0) throw CLI::RuntimeError(status);
   });

@@ -1,6 +1,6 @@
 #pragma once
 
-// Per-scan timing figures the semap-kitti subcommands print.
+// Per-scan timing figures that semap-dataset kitti-raw and semantickitti print.
 #include <algorithm>
 #include <cstddef>
 #include <vector>

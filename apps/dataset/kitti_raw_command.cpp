@@ -16,15 +16,17 @@
 #include "progress_meter.hpp"
 #include "scan_timing.hpp"
 #include "semap/common/config.hpp"
+#include "semap/common/logging.hpp"
 #include "semap/estimation/evaluation.hpp"
 #include "semap/estimation/oxts_reader.hpp"
 #include "semap/estimation/pose_history.hpp"
 #include "semap/estimation/so3.hpp"
 #include "semap/map_io/map_export.hpp"
-#include "semap/map_io/semantic_kitti_io.hpp"
 #include "semap/mapping/cloud_transform.hpp"
 #include "semap/mapping/semantic_map.hpp"
 #include "semap/mapping/smap_io.hpp"
+#include "semap/perception/datasets/dataset.hpp"
+#include "semap/perception/datasets/velodyne_bin.hpp"
 #include "semap/perception/kitti_calib_text.hpp"
 #include "semap/perception/lidar_projection.hpp"
 #include "top_view.hpp"
@@ -137,7 +139,8 @@ ScanStats map_scans(const KittiRawDrive& drive, std::size_t first, std::size_t l
       ++stats.without_pose;
       continue;
     }
-    const std::vector<Eigen::Vector4f> raw = map_io::read_kitti_scan(drive.scans[i]);
+    const std::vector<Eigen::Vector4f> raw =
+        perception::datasets::read_velodyne_bin(drive.scans[i]);
     std::vector<Eigen::Vector3f> points(raw.size());
     for (std::size_t k = 0; k < raw.size(); ++k) points[k] = raw[k].head<3>();
     auto start = std::chrono::steady_clock::now();
@@ -263,7 +266,7 @@ int run(const CLI::App& command, const RawOptions& o) {
   // The map follows the first filter run (the InEKF unless --filter eskf).
   const est::PoseHistory history = history_of(runs.front().run, data.imu.front().stamp);
   mapping::SemanticMap map(params);
-  ProgressMeter meter("semap-kitti raw", o.progress_seconds);
+  ProgressMeter meter("semap-dataset kitti-raw", o.progress_seconds);
   const ScanStats s =
       map_scans(drive, o.first, last, history, *labels, camera, body_from_velo, map, meter);
   const double mapping_seconds = meter.elapsed_seconds();
@@ -289,7 +292,7 @@ int run(const CLI::App& command, const RawOptions& o) {
 bool is_bad_input(const std::exception& e) {
   return dynamic_cast<const DriveError*>(&e) != nullptr ||
          dynamic_cast<const perception::CalibrationError*>(&e) != nullptr ||
-         dynamic_cast<const map_io::KittiError*>(&e) != nullptr ||
+         dynamic_cast<const perception::datasets::DatasetError*>(&e) != nullptr ||
          dynamic_cast<const common::ConfigError*>(&e) != nullptr;  // model card
 }
 
@@ -297,7 +300,7 @@ int run_guarded(const CLI::App& command, const RawOptions& o) {
   try {
     return run(command, o);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "semap-kitti raw: %s\n", e.what());
+    std::fprintf(stderr, "semap-dataset kitti-raw: %s\n", e.what());
     return is_bad_input(e) ? 2 : 1;
   }
 }
@@ -308,7 +311,7 @@ void add_kitti_raw_command(CLI::App& app) {
   auto options = std::make_shared<RawOptions>();
   RawOptions& o = *options;
   CLI::App* command = app.add_subcommand(
-      "raw",
+      "kitti-raw",
       "Run the Left-InEKF (and ESKF) on a KITTI raw drive's OXTS-derived IMU and noisy GNSS, "
       "label each Velodyne scan through image_02 and build an S-BKI map; prints unaligned ATE, "
       "heading RMSE and per-scan timing (docs/kitti.md)");
@@ -344,16 +347,18 @@ void add_kitti_raw_command(CLI::App& app) {
                       "progress line on stderr every so many seconds (0: none)");
   add_map_parameter_options(*command, o.map);
   command->callback([command, options] {
+    common::setup_logging("warn");
     const RawOptions& opts = *options;
     if (opts.segmenter.empty() == opts.labels.empty()) {
-      std::fprintf(stderr, "semap-kitti raw: give one of --segmenter or --labels\n");
+      std::fprintf(stderr, "semap-dataset kitti-raw: give one of --segmenter or --labels\n");
       throw CLI::RuntimeError(2);
     }
     if (opts.gnss_sigma != "packet") {
       try {
         if (std::stod(opts.gnss_sigma) <= 0.0) throw std::invalid_argument("not positive");
       } catch (const std::exception&) {
-        std::fprintf(stderr, "semap-kitti raw: --gnss-sigma %s: a positive number or `packet`\n",
+        std::fprintf(stderr,
+                     "semap-dataset kitti-raw: --gnss-sigma %s: a positive number or `packet`\n",
                      opts.gnss_sigma.c_str());
         throw CLI::RuntimeError(2);
       }

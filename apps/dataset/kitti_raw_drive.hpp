@@ -1,7 +1,7 @@
 #pragma once
 
-// The files of one KITTI raw drive (a *_sync or *_extract folder) that `semap-kitti raw` reads,
-// and the labels of a scan's camera image.
+// The files of one KITTI raw drive (a *_sync or *_extract folder) that `semap-dataset kitti-raw`
+// reads, and the labels of a scan's camera image.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
