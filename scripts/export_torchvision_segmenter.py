@@ -144,6 +144,19 @@ def verify_with_opencv(onnx_file, model, width, height, threads):
     return diff, scale
 
 
+# Cityscapes' 19 training classes in train-id order and their official colours (the same as
+# models/enet-cityscapes.yaml): --names cityscapes.
+CITYSCAPES = [
+    ("road", (128, 64, 128)), ("sidewalk", (244, 35, 232)), ("building", (70, 70, 70)),
+    ("wall", (102, 102, 156)), ("fence", (190, 153, 153)), ("pole", (153, 153, 153)),
+    ("traffic light", (250, 170, 30)), ("traffic sign", (220, 220, 0)),
+    ("vegetation", (107, 142, 35)), ("terrain", (152, 251, 152)), ("sky", (70, 130, 180)),
+    ("person", (220, 20, 60)), ("rider", (255, 0, 0)), ("car", (0, 0, 142)),
+    ("truck", (0, 0, 70)), ("bus", (0, 60, 100)), ("train", (0, 80, 100)),
+    ("motorcycle", (0, 0, 230)), ("bicycle", (119, 11, 32)),
+]
+
+
 def palette(n):
     """Distinct colours for generic classes: hues around the circle, two brightnesses."""
     import colorsys
@@ -174,7 +187,8 @@ def write_card(path, args, arch_title, onnx_name, width, height, names, paramete
         lines += ["#",
                   "# RANDOM WEIGHTS: exported without --weights. This network labels nothing;",
                   "# it is for compatibility and speed checks only (semap-segment --check,",
-                  "# perception_bench --model-card). The class names are placeholders."]
+                  "# perception_bench --model-card)."
+                  + (" The class names are placeholders." if not args.names else "")]
     else:
         lines += [f"# Weights: {os.path.abspath(args.weights)}"
                   + (f" ({aux_dropped} aux_classifier tensors not exported)" if aux_dropped
@@ -216,7 +230,8 @@ def main():
     parser.add_argument("--weights", help="a state_dict (.pt) of the network with --classes")
     parser.add_argument("--size", required=True, help="input size WxH, e.g. 640x480")
     parser.add_argument("--classes", required=True, type=int, help="output classes N")
-    parser.add_argument("--names", help="class names, comma-separated (default class_0 ...)")
+    parser.add_argument("--names", help="class names, comma-separated (default class_0 ...), or "
+                        "'cityscapes': the 19 training classes and their palette")
     parser.add_argument("--out", required=True, help="folder for NAME.onnx and NAME.yaml")
     parser.add_argument("--name", help="file stem (default ARCH-mobilenetv3-WxH[-random])")
     parser.add_argument("--opset", type=int, default=11, choices=(11, 13))
@@ -232,7 +247,13 @@ def main():
         fail(f"--size: {width}x{height} is too small (at least 32x32)")
     if not 1 <= args.classes <= 255:
         fail(f"--classes: expected 1..255, got {args.classes}")
-    if args.names:
+    args.colors = palette(args.classes)
+    if args.names == "cityscapes":
+        if args.classes != len(CITYSCAPES):
+            fail(f"--names cityscapes: the {len(CITYSCAPES)} training classes, not {args.classes}")
+        names = [n for n, _ in CITYSCAPES]
+        args.colors = [c for _, c in CITYSCAPES]
+    elif args.names:
         names = [n.strip() for n in args.names.split(",")]
         if len(names) != args.classes:
             fail(f"--names: {len(names)} names for {args.classes} classes")
@@ -241,7 +262,6 @@ def main():
             fail("--names: each name must be unique, non-empty and without YAML punctuation")
     else:
         names = [f"class_{i}" for i in range(args.classes)]
-    args.colors = palette(args.classes)
 
     torch.set_num_threads(args.threads)
     # torch 1.13 warns about constants' shapes at opset 13; the export is checked below anyway.
