@@ -373,7 +373,10 @@ int model_cards(const Options& o, onboard::OnboardConfig config, const bench::Sc
       "threads %d\n",
       real->source.c_str(), o.seconds, kCameraHz, o.stride, o.threads);
   std::vector<std::filesystem::path> cards;
-  if (!o.baseline.empty() && o.baseline != o.model_card) cards.push_back(o.baseline);
+  std::error_code ec;
+  if (!o.baseline.empty() && !std::filesystem::equivalent(o.baseline, o.model_card, ec)) {
+    cards.push_back(o.baseline);
+  }
   cards.push_back(o.model_card);
   std::vector<CardFigures> figures;
   for (const auto& card : cards) figures.push_back(measure_card(o, config, *real, card));
