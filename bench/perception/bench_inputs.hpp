@@ -44,6 +44,7 @@ estimation::StampedPose circle_pose(double t, common::Stamp stamp);
 struct Spread {
   double p50 = 0.0;
   double p90 = 0.0;
+  double p99 = 0.0;
 };
 
 inline Spread spread(std::vector<double> v) {
@@ -52,7 +53,7 @@ inline Spread spread(std::vector<double> v) {
   const auto at = [&](double q) {
     return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
   };
-  return {at(0.5), at(0.9)};
+  return {at(0.5), at(0.9), at(0.99)};
 }
 
 // Runs f() n times; milliseconds per call.

@@ -2,18 +2,31 @@
 // medians and 90th percentiles (decode, segment, depth -> points, posing, map insert), then a
 // steady-state run of the real PerceptionStage and MappingStage on their own threads, fed at
 // 15 Hz with YUYV colour and aligned Z16 depth while a pose thread drives a circle.
-// The last line is parsed by scripts:
+//
+// With --model-card CARD it measures networks instead (issue 31): for the shipped semap-seg
+// card (the baseline, --baseline) and then CARD, on real RGB-D frames (the five Redwood frames
+// of ../shared/data/real/redwood, MJPEG colour and Z16 depth in millimetres; the simulated
+// scene where they are absent): the network's forward pass on an image resized to the card's
+// input, the whole segment() of a 640x480 frame (p50/p99 over --frames), and the 15 Hz steady
+// state of the same stages with the card's segmenter, then a table of both.
+//
+// The last line is parsed by scripts (in --model-card mode: CARD's steady state):
 //   steady state: F frames/s mapped, latency p50 A ms p99 B ms, cpu C cores
 #include <tbb/task_arena.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -54,6 +67,8 @@ struct Options {
   int stride = 2;      // every 2nd pixel: finer than the map's 0.2 m at 640x480 still
   std::string infer = "320x240";
   std::filesystem::path model_card;  // a trained network instead of the synthetic one
+  std::filesystem::path baseline = SEMAP_SOURCE_DIR "/models/semap-seg.yaml";
+  std::filesystem::path redwood = SEMAP_SHARED_DATA_DIR "/real/redwood";
 };
 
 void row(const std::string& what, const bench::Spread& s) {
@@ -87,13 +102,8 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
   const cv::Mat bgr = semap::drivers::to_mat(scene.yuyv, jpeg);
   perception::Segmentation seg;
   char what[160];
-  if (model.gflops > 0.0) {
-    std::snprintf(what, sizeof what, "segment ONNX at %s (%.2f GFLOP, %d -> %d classes)",
-                  o.infer.c_str(), model.gflops, model.classes, kMapClasses);
-  } else {
-    std::snprintf(what, sizeof what, "segment ONNX at %s (%s, %d -> %d classes)", o.infer.c_str(),
-                  o.model_card.filename().c_str(), model.classes, kMapClasses);
-  }
+  std::snprintf(what, sizeof what, "segment ONNX at %s (%.2f GFLOP, %d -> %d classes)",
+                o.infer.c_str(), model.gflops, model.classes, kMapClasses);
   row(what, bench::time_ms(n, [&](int) { seg = onnx.segment(bgr); }));
   perception::PaletteSegmenter palette(
       perception::cityscapes_palette(perception::sim_cityscapes_mapping()), kMapClasses);
@@ -150,10 +160,16 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
 struct SteadyState {
   double mapped_hz = 0, cpu_cores = 0;
   onboard::LatencyPercentiles latency;
+  std::uint64_t frames = 0, clouds = 0, skipped = 0;  // the perception stage's
+};
+
+// Colour and depth frames as the drivers deliver them; the steady state pushes them in turn.
+struct FramePairs {
+  std::vector<common::ImageFrame> colour, depth;
 };
 
 SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
-                         const bench::SceneImages& scene, const bench::BenchModel& model) {
+                         const FramePairs& input, const std::filesystem::path& card) {
   using common::OverflowPolicy;
   common::SpscRing<common::ImageFrame> colour_ring(config.camera.ring, OverflowPolicy::kDropOldest);
   common::SpscRing<common::ImageFrame> depth_ring(config.depth.ring, OverflowPolicy::kDropOldest);
@@ -161,7 +177,7 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   onboard::SharedPoseHistory poses(config.estimator.history);
   onboard::SegmenterConfig seg;
   seg.kind = onboard::SegmenterConfig::Kind::kDnn;
-  seg.model_card = model.card;
+  seg.model_card = card;
   onboard::PerceptionStage perception(config.camera, config.depth,
                                       onboard::make_segmenter(seg, config.map.params.num_classes),
                                       colour_ring, &depth_ring, poses, cloud_ring);
@@ -189,7 +205,8 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   const auto frames = static_cast<std::uint32_t>(o.seconds * kCameraHz);
   for (std::uint32_t i = 0; i < frames; ++i) {
     std::this_thread::sleep_until(start + i * period);
-    common::ImageFrame colour = scene.yuyv, depth = scene.z16;
+    common::ImageFrame colour = input.colour[i % input.colour.size()];
+    common::ImageFrame depth = input.depth[i % input.depth.size()];
     colour.stamp = depth.stamp = common::Stamp::now();
     colour.sequence = depth.sequence = i;
     colour_ring.try_push(std::move(colour));
@@ -205,6 +222,8 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   const auto p = perception.stats();
 
   const auto drops = [](const auto& ring) { return ring.counters().drops(); };
+  // Frames passed over or without a depth partner never reach the segmenter.
+  const std::uint64_t segmented = p.frames - std::min(p.frames, p.skipped + p.unpaired);
   const std::uint64_t ring_drops = drops(colour_ring) + drops(cloud_ring);
   std::printf("steady state over %.1f s (%u frames pushed at %.0f Hz, stride %d):\n", wall, frames,
               kCameraHz, config.depth.points.stride);
@@ -212,7 +231,7 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
       "  perception: %lu frames, %lu clouds, segment mean %.1f ms max %.1f ms, %.0f "
       "points/cloud, frame -> posed cloud p50 %.1f ms p99 %.1f ms\n",
       p.frames, p.clouds,
-      p.frames ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
+      segmented ? 1e3 * p.segment_seconds_total / static_cast<double>(segmented) : 0.0,
       1e3 * p.segment_seconds_max,
       p.clouds ? static_cast<double>(p.points) / static_cast<double>(p.clouds) : 0.0,
       perception.latency().percentiles().p50_ms, perception.latency().percentiles().p99_ms);
@@ -222,7 +241,160 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   std::printf("  drops: %lu (ring %lu, skipped %lu, unpaired %lu, without pose %lu, bad %lu)\n",
               ring_drops + p.skipped + p.unpaired + p.without_pose + p.bad_frames, ring_drops,
               p.skipped, p.unpaired, p.without_pose, p.bad_frames);
-  return {static_cast<double>(m.scans) / wall, cpu / wall, mapping.latency().percentiles()};
+  return {static_cast<double>(m.scans) / wall,
+          cpu / wall,
+          mapping.latency().percentiles(),
+          p.frames,
+          p.clouds,
+          p.skipped};
+}
+
+void print_steady_state(const SteadyState& s) {
+  std::printf(
+      "steady state: %.1f frames/s mapped, latency p50 %.0f ms p99 %.0f ms, cpu %.2f cores\n",
+      s.mapped_hz, s.latency.p50_ms, s.latency.p99_ms, s.cpu_cores);
+}
+
+// Real RGB-D frames for --model-card: the Redwood frames (colour/*.jpg as MJPEG frames, depth/
+// *.png, uint16 millimetres), with their camera's intrinsics. Empty when absent or unreadable.
+struct RealFrames {
+  FramePairs pairs;
+  std::vector<cv::Mat> bgr;  // the colour frames decoded, for the per-frame figures
+  perception::PinholeIntrinsics intrinsics;
+  float depth_scale = 0.001f;
+  std::string source;
+};
+
+std::optional<RealFrames> redwood_frames(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::vector<std::filesystem::path> colours;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "color", ec)) {
+    if (entry.path().extension() == ".jpg") colours.push_back(entry.path());
+  }
+  if (ec || colours.empty()) return std::nullopt;
+  std::sort(colours.begin(), colours.end());
+  RealFrames real;
+  for (const auto& colour_file : colours) {
+    const auto depth_file = dir / "depth" / colour_file.filename().replace_extension(".png");
+    const cv::Mat bgr = cv::imread(colour_file.string(), cv::IMREAD_COLOR);
+    const cv::Mat z16 = cv::imread(depth_file.string(), cv::IMREAD_UNCHANGED);
+    if (bgr.empty() || z16.type() != CV_16UC1 || bgr.size() != z16.size() || bgr.cols != kWidth ||
+        bgr.rows != kHeight) {
+      return std::nullopt;
+    }
+    common::ImageFrame colour;
+    colour.format = common::PixelFormat::kMjpeg;
+    colour.width = static_cast<std::uint32_t>(bgr.cols);
+    colour.height = static_cast<std::uint32_t>(bgr.rows);
+    std::ifstream in(colour_file, std::ios::binary);
+    colour.data.assign(std::istreambuf_iterator<char>(in), {});
+    common::ImageFrame depth;
+    depth.format = common::PixelFormat::kZ16;
+    depth.width = colour.width;
+    depth.height = colour.height;
+    depth.stride = 2 * depth.width;
+    const cv::Mat packed = z16.clone();
+    depth.data.assign(packed.datastart, packed.dataend);
+    real.pairs.colour.push_back(std::move(colour));
+    real.pairs.depth.push_back(std::move(depth));
+    real.bgr.push_back(bgr);
+  }
+  // camera_primesense.json: Open3D's PrimeSense defaults.
+  real.intrinsics = {kWidth, kHeight, 525.0f, 525.0f, 319.5f, 239.5f};
+  real.source = "Redwood " + dir.string() + " (" + std::to_string(real.bgr.size()) +
+                " RGB-D frames, MJPEG + Z16 mm)";
+  return real;
+}
+
+struct CardFigures {
+  std::string name, input;
+  double load = 0.0;  // 1-minute load average when the card's run began
+  bench::Spread forward, segment;
+  SteadyState steady;
+};
+
+// One card: its forward pass and segment() per frame, then the 15 Hz steady state.
+CardFigures measure_card(const Options& o, onboard::OnboardConfig config, const RealFrames& real,
+                         const std::filesystem::path& card_file) {
+  const auto card = perception::load_model_card(card_file);
+  CardFigures f;
+  f.name = card_file.filename().string();
+  f.input = std::to_string(card.input_width) + "x" + std::to_string(card.input_height);
+  double load[3] = {};
+  getloadavg(load, 3);
+  f.load = load[0];
+  std::printf(
+      "\n%s: %s network (%s), input %s, %zu classes -> map K = %d, %d OpenCV threads, "
+      "load %.2f %.2f %.2f\n",
+      card_file.c_str(), std::string(perception::format_name(card.format)).c_str(),
+      card.model_file.filename().c_str(), f.input.c_str(), card.classes.size(),
+      card.num_map_classes, card.threads, load[0], load[1], load[2]);
+  perception::DnnSegmenter segmenter(card);  // reads the network, runs it once
+  std::vector<cv::Mat> resized;
+  for (const cv::Mat& bgr : real.bgr) {
+    cv::Mat r;
+    cv::resize(bgr, r, {card.input_width, card.input_height}, 0, 0, cv::INTER_AREA);
+    resized.push_back(r);
+  }
+  const auto n = resized.size();
+  f.forward = bench::time_ms(o.frames, [&](int i) { segmenter.forward(resized[i % n]); });
+  perception::Segmentation seg;
+  f.segment = bench::time_ms(o.frames, [&](int i) { seg = segmenter.segment(real.bgr[i % n]); });
+  std::printf("  forward at %-9s (network only, %d frames)          p50 %7.1f ms  p99 %7.1f ms\n",
+              f.input.c_str(), o.frames, f.forward.p50, f.forward.p99);
+  std::printf("  segment %dx%d (resize, forward, classes, labels)   p50 %7.1f ms  p99 %7.1f ms\n",
+              kWidth, kHeight, f.segment.p50, f.segment.p99);
+
+  config.map.params.num_classes = card.num_map_classes;
+  f.steady = steady_state(o, config, real.pairs, card_file);
+  print_steady_state(f.steady);
+  return f;
+}
+
+int model_cards(const Options& o, onboard::OnboardConfig config, const bench::SceneImages& scene) {
+  std::optional<RealFrames> real = redwood_frames(o.redwood);
+  if (real) {
+    config.camera.intrinsics = real->intrinsics;
+    config.depth.depth_scale = real->depth_scale;
+  } else {
+    std::printf(
+        "%s: no Redwood frames (../shared/data/real, see its README.md); the simulated "
+        "scene instead\n",
+        o.redwood.c_str());
+    real.emplace();
+    real->pairs.colour = {scene.yuyv};
+    real->pairs.depth = {scene.z16};
+    real->bgr = {scene.camera_bgr};
+    real->depth_scale = config.depth.depth_scale;
+    real->source = "the simulated scene (YUYV + Z16)";
+  }
+  std::printf(
+      "frames: %s; steady state %.0f s at %.0f Hz per card, depth stride %d, map "
+      "threads %d\n",
+      real->source.c_str(), o.seconds, kCameraHz, o.stride, o.threads);
+  std::vector<std::filesystem::path> cards;
+  std::error_code ec;
+  if (!o.baseline.empty() && !std::filesystem::equivalent(o.baseline, o.model_card, ec)) {
+    cards.push_back(o.baseline);
+  }
+  cards.push_back(o.model_card);
+  std::vector<CardFigures> figures;
+  for (const auto& card : cards) figures.push_back(measure_card(o, config, *real, card));
+
+  std::printf(
+      "\n| card | input | load | forward p50 / p99 | segment 640x480 p50 / p99 | "
+      "15 Hz: frames/s mapped | latency p50 / p99 | CPU cores |\n"
+      "|---|---|---|---|---|---|---|---|\n");
+  for (const auto& f : figures) {
+    std::printf(
+        "| %s | %s | %.2f | %.1f / %.1f ms | %.1f / %.1f ms | %.1f | %.0f / %.0f ms | "
+        "%.2f |\n",
+        f.name.c_str(), f.input.c_str(), f.load, f.forward.p50, f.forward.p99, f.segment.p50,
+        f.segment.p99, f.steady.mapped_hz, f.steady.latency.p50_ms, f.steady.latency.p99_ms,
+        f.steady.cpu_cores);
+  }
+  print_steady_state(figures.back().steady);
+  return 0;
 }
 
 }  // namespace
@@ -238,9 +410,15 @@ int main(int argc, char** argv) {
   app.add_option("--stride", o.stride, "pixel stride of depth -> points in the steady state")
       ->check(CLI::Range(1, 16));
   app.add_option("--infer", o.infer, "network input size WxH of the synthetic network");
-  app.add_option("--model-card", o.model_card, "run this network (e.g. models/semap-seg.yaml)")
+  app.add_option("--model-card", o.model_card,
+                 "measure this network on real frames against the baseline card")
       ->check(CLI::ExistingFile);
+  app.add_option("--baseline", o.baseline, "the card measured first with --model-card (\"\": none)")
+      ->capture_default_str();
+  app.add_option("--redwood", o.redwood, "Redwood RGB-D frames for --model-card")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (!o.model_card.empty() && app.count("--seconds") == 0) o.seconds = 10.0;
   int infer_w = 0, infer_h = 0;
   if (std::sscanf(o.infer.c_str(), "%dx%d", &infer_w, &infer_h) != 2 || infer_w < 8 ||
       infer_h < 8) {
@@ -267,23 +445,18 @@ int main(int argc, char** argv) {
 
   const TempDir dir;
   const auto scene = bench::render_scene(config.camera, config.depth.depth_scale);
-  bench::BenchModel model;
-  if (o.model_card.empty()) {
-    model = bench::write_bench_model(dir.path, infer_w, infer_h, kMapClasses, o.cv_threads);
-  } else {
-    const auto card = perception::load_model_card(o.model_card);
-    model.card = o.model_card;
-    model.classes = static_cast<int>(card.classes.size());
-    o.infer = std::to_string(card.input_width) + "x" + std::to_string(card.input_height);
-  }
   double load[3] = {};
   getloadavg(load, 3);
+  if (!o.model_card.empty()) {
+    std::printf("perception_bench --model-card: %dx%d frames, load %.2f %.2f %.2f\n", kWidth,
+                kHeight, load[0], load[1], load[2]);
+    return model_cards(o, config, scene);
+  }
+  const bench::BenchModel model =
+      bench::write_bench_model(dir.path, infer_w, infer_h, kMapClasses, o.cv_threads);
   std::printf("perception_bench: %dx%d, map threads %d, OpenCV threads %d, load %.2f %.2f %.2f\n",
               kWidth, kHeight, o.threads, o.cv_threads, load[0], load[1], load[2]);
   per_stage(o, config, scene, model);
-  const SteadyState s = steady_state(o, config, scene, model);
-  std::printf(
-      "steady state: %.1f frames/s mapped, latency p50 %.0f ms p99 %.0f ms, cpu %.2f cores\n",
-      s.mapped_hz, s.latency.p50_ms, s.latency.p99_ms, s.cpu_cores);
+  print_steady_state(steady_state(o, config, {{scene.yuyv}, {scene.z16}}, model.card));
   return 0;
 }
