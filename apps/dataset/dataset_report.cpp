@@ -32,9 +32,11 @@ std::size_t write_dataset_outputs(const std::filesystem::path& out, onboard::Pip
   const std::size_t unreadable = rig.selected() - rig.handed_over();
   const std::size_t not_mapped = rig.selected() - static_cast<std::size_t>(m.scans);
   const std::size_t skipped_by_reader = problems.size() - unreadable;
-  const auto mean_ms = [](double total_s, std::uint64_t n) {
-    return n ? 1e3 * total_s / static_cast<double>(n) : 0.0;
-  };
+  const onboard::LatencyWindow none;
+  const auto* stage = pipeline.perception_stage();
+  const auto segment = (stage ? stage->segment_time() : none).percentiles();
+  const auto points = (stage ? stage->points_time() : none).percentiles();
+  const auto insert = pipeline.mapping_stage().insert_time().percentiles();
 
   std::ofstream json(out / "summary.json");
   json << "{\n"
@@ -50,12 +52,12 @@ std::size_t write_dataset_outputs(const std::filesystem::path& out, onboard::Pip
   }
   json << "],\n"
        << fmt::format(
-              "  \"time_ms\": {{\"segment_mean\": {:.2f}, \"segment_max\": {:.2f}, "
-              "\"insert_mean\": {:.2f}, \"insert_max\": {:.2f}, \"frame_to_map_p50\": {:.2f}, "
+              "  \"time_ms\": {{\"segment_p50\": {:.2f}, \"segment_p95\": {:.2f}, "
+              "\"points_p50\": {:.2f}, \"points_p95\": {:.2f}, \"insert_p50\": {:.2f}, "
+              "\"insert_p95\": {:.2f}, \"frame_to_map_p50\": {:.2f}, "
               "\"frame_to_map_p99\": {:.2f}}},\n",
-              mean_ms(p.segment_seconds_total, p.frames), 1e3 * p.segment_seconds_max,
-              mean_ms(m.insert_seconds_total, m.scans), 1e3 * m.insert_seconds_max, latency.p50_ms,
-              latency.p99_ms)
+              segment.p50_ms, segment.p95_ms, points.p50_ms, points.p95_ms, insert.p50_ms,
+              insert.p95_ms, latency.p50_ms, latency.p99_ms)
        << fmt::format("  \"frames_per_s\": {:.2f},\n",
                       wall_s > 0 ? static_cast<double>(m.scans) / wall_s : 0.0)
        << fmt::format(

@@ -180,7 +180,7 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   seg.model_card = card;
   onboard::PerceptionStage perception(config.camera, config.depth,
                                       onboard::make_segmenter(seg, config.map.params.num_classes),
-                                      colour_ring, &depth_ring, poses, cloud_ring);
+                                      colour_ring, &depth_ring, nullptr, poses, cloud_ring);
   onboard::MappingStage mapping(config.map, cloud_ring, nullptr, {});
 
   // The estimation stage's part: filter poses at 200 Hz, stamped now.

@@ -39,6 +39,7 @@ LatencyPercentiles LatencyWindow::percentiles() const {
     return *nth;
   };
   p.p50_ms = rank(0.50);
+  p.p95_ms = rank(0.95);
   p.p99_ms = rank(0.99);
   return p;
 }

@@ -146,6 +146,7 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
+  insert_time_.record(seconds);
   stage_.figures().scans++;
   stage_.figures().points += cloud.size();
   stage_.figures().blocks_changed += result.updated_blocks.size();

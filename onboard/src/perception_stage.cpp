@@ -23,6 +23,10 @@ std::string frame_name(const common::ImageFrame& f) {
          std::to_string(f.height) + ", stamp " + std::to_string(f.stamp.ns) + " ns)";
 }
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 std::string scan_name(const common::PointScan& s) {
   return "scan " + std::to_string(s.sequence) + " (" + std::to_string(s.points.size()) +
          " points, stamp " + std::to_string(s.stamp.ns) + " ns)";
@@ -262,8 +266,8 @@ perception::Segmentation PerceptionStage::segment(const common::ImageFrame& colo
                                                   const cv::Mat& image) {
   const auto t0 = std::chrono::steady_clock::now();
   perception::Segmentation segmentation = segmenter_->segment(image);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = seconds_since(t0);
+  segment_time_.record(seconds);
   stage_.figures().segment_seconds_total += seconds;
   stage_.figures().segment_seconds_max = std::max(stage_.figures().segment_seconds_max, seconds);
   if (observer_) observer_(colour.sequence, colour.stamp, image, segmentation);
@@ -292,10 +296,12 @@ void PerceptionStage::process(const common::ImageFrame& colour, const common::Im
       depth_m = perception::depth_metres(z16, depth_.depth_scale);
     }
     const perception::Segmentation segmentation = segment(colour, image);
-    queue_for_pose(
+    const auto t0 = std::chrono::steady_clock::now();
+    common::LabeledCloud cloud =
         perception::cloud_from_depth(depth_m, segmentation, intrinsics, body_from_optical,
-                                     depth_.points, stage_.figures().dropped),
-        colour.stamp, colour.sequence);
+                                     depth_.points, stage_.figures().dropped);
+    points_time_.record(seconds_since(t0));
+    queue_for_pose(std::move(cloud), colour.stamp, colour.sequence);
   } catch (const std::exception& e) {
     reject(frame_name(colour), e.what());
   }
@@ -306,18 +312,22 @@ void PerceptionStage::process_scan(const common::PointScan& scan,
   auto& drops = stage_.figures().dropped;
   const LidarConfig& lidar = depth_.lidar;
   try {
-    if (!colour) {
-      return queue_for_pose(
-          perception::occupied_lidar_points(scan.points, segmenter_->num_classes(),
-                                            lidar.body_from_lidar, depth_.points, drops),
-          scan.stamp, scan.sequence);
+    common::LabeledCloud cloud;
+    if (colour) {
+      const cv::Mat image = colour_image(*colour);
+      if (image.empty()) return;
+      const perception::Segmentation segmentation = segment(*colour, image);
+      const auto t0 = std::chrono::steady_clock::now();
+      cloud = perception::label_lidar_points(scan.points, segmentation, lidar.camera,
+                                             lidar.body_from_lidar, depth_.points, drops);
+      points_time_.record(seconds_since(t0));
+    } else {
+      const auto t0 = std::chrono::steady_clock::now();
+      cloud = perception::occupied_lidar_points(scan.points, segmenter_->num_classes(),
+                                                lidar.body_from_lidar, depth_.points, drops);
+      points_time_.record(seconds_since(t0));
     }
-    const cv::Mat image = colour_image(*colour);
-    if (image.empty()) return;
-    const perception::Segmentation segmentation = segment(*colour, image);
-    queue_for_pose(perception::label_lidar_points(scan.points, segmentation, lidar.camera,
-                                                  lidar.body_from_lidar, depth_.points, drops),
-                   scan.stamp, scan.sequence);
+    queue_for_pose(std::move(cloud), scan.stamp, scan.sequence);
   } catch (const std::exception& e) {
     reject(scan_name(scan), e.what());
   }

@@ -5,8 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
+#include <map>
 #include <set>
 #include <thread>
 #include <tuple>
@@ -14,6 +17,7 @@
 #include "semap/map_io/map_export.hpp"
 #include "semap/onboard/pipeline.hpp"
 #include "semap/perception/datasets/depth_png.hpp"
+#include "semap/perception/datasets/kitti_odometry.hpp"
 #include "semap/perception/datasets/redwood.hpp"
 
 namespace semap::onboard {
@@ -128,6 +132,76 @@ TEST(DatasetRig, RedwoodFramesAgreeWithTheMapOfTheFramesBefore) {
   EXPECT_GE(posed, 0.90);
   EXPECT_LT(identity, posed - 0.10);
   EXPECT_LT(wrong, posed - 0.10);
+}
+
+// KITTI odometry sequence 00's first scan, mapped whole (no image) through the pipeline: the
+// road in front of the car lies where the Velodyne's mount, 1.73 m above it, puts it.
+TEST(DatasetRig, KittiScanPutsTheRoadBelowTheVelodyneMount) {
+  const auto root = std::filesystem::path(SEMAP_SHARED_DATA_DIR) / "real" / "kitti_odometry_00";
+  if (!std::filesystem::exists(root)) {
+    GTEST_SKIP() << root << " is absent (../shared/data/real, see its README.md)";
+  }
+  // Tr of sequence 00 as its README quotes it; P2 does not matter for whole scans.
+  const auto calib = std::filesystem::path(::testing::TempDir()) / "kitti00_calib.txt";
+  std::ofstream(calib)
+      << "P2: 718.856 0 607.1928 45.38225 0 718.856 185.2157 -0.1130887 0 0 1 0.003779761\n"
+         "Tr: 4.276802385584e-04 -9.999672484946e-01 -8.084491683471e-03 -1.198459927713e-02 "
+         "-7.210626507497e-03 8.081198471645e-03 -9.999413164504e-01 -5.403984729748e-02 "
+         "9.999738645903e-01 4.859485810390e-04 -7.206933692422e-03 -2.921968648686e-01\n";
+  const auto sequence =
+      datasets::read_kitti_odometry(root / "sequences" / "00", {}, {.calib = calib});
+  ASSERT_EQ(sequence.frames.size(), 1u);
+
+  OnboardConfig config;
+  auto& p = config.map.params;
+  p.resolution = 0.1f;
+  p.block_depth = 3;
+  p.ell = 0.3f;
+  p.ds_res = 0.1f;
+  p.free_res = 2.0f;
+  p.max_range = 30.0f;
+  p.num_classes = 2;
+  config.map.palette = mapping::ClassPalette::defaults(2);
+  config.map.checkpoint_s = 0.0;
+  config.dds.enabled = false;
+  config.costmap.reset();
+  config.segmenter.kind = SegmenterConfig::Kind::kGeometry;
+  config.depth.source = DepthSource::kLidar;
+  config.depth.points.max_range = 30.0f;
+  Pipeline pipeline(config, [&](const SensorRings& rings) {
+    return std::make_unique<DatasetRig>(sequence, "kitti 00", Eigen::Isometry3f::Identity(),
+                                        DatasetSelection{}, rings);
+  });
+  pipeline.start();
+  while (!pipeline.finished()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  pipeline.stop();
+  ASSERT_EQ(pipeline.mapping().scans, 1u);
+  const auto perception = pipeline.perception();
+  ASSERT_TRUE(perception);
+  // Every one of the 124,668 points is in the cloud or counted (beyond 30 m).
+  EXPECT_EQ(perception->points + perception->dropped.out_of_range, 124668u);
+
+  // In each column of cells 5-15 m ahead within 2 m of the centre line, the most probable
+  // occupied cell: the kernel (ell 0.3) spreads a surface's evidence a few cells up and down,
+  // fading with distance, so the surface is where the probability peaks.
+  std::map<std::pair<long, long>, map_io::OccupiedCell> peak;
+  for (const auto& cell : map_io::occupied_cells(pipeline.map().layers())) {
+    const auto& c = cell.centre;
+    if (c.x() < 5 || c.x() > 15 || std::abs(c.y()) > 2) continue;
+    const std::pair<long, long> column{std::lround(c.x() * 10), std::lround(c.y() * 10)};
+    const auto [it, added] = peak.emplace(column, cell);
+    if (!added && cell.probability > it->second.probability) it->second = cell;
+  }
+  ASSERT_GT(peak.size(), 500u);
+  std::vector<double> heights;
+  for (const auto& [column, cell] : peak) heights.push_back(cell.centre.z());
+  std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
+  const double road = heights[heights.size() / 2];
+  std::printf("KITTI 00 scan 0 mapped: road 5-15 m ahead at z = %.3f m (%zu columns)\n", road,
+              heights.size());
+  // Within a cell and a half (0.15 m) of -1.73 m. A flipped z axis would put it at +1.73 m,
+  // the camera frame taken for the LiDAR's would leave no road ahead at all.
+  EXPECT_NEAR(road, -1.73, 0.15);
 }
 
 }  // namespace

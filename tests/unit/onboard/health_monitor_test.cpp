@@ -14,6 +14,7 @@ TEST(LatencyWindow, NearestRankPercentilesOfTheLastItems) {
   auto p = w.percentiles();
   EXPECT_EQ(p.count, 100u);
   EXPECT_FLOAT_EQ(p.p50_ms, 50.0f);
+  EXPECT_FLOAT_EQ(p.p95_ms, 95.0f);
   EXPECT_FLOAT_EQ(p.p99_ms, 99.0f);
   // The window keeps the last 100: fifty more of 1 s push the median up to 1 s.
   for (int i = 0; i < 50; ++i) w.record(1.0);
@@ -39,7 +40,7 @@ TEST(LatencyWindow, RecordsFromAnotherThreadWhileRead) {
 TEST(HealthMonitor, RatesComeFromCountGrowthBetweenReports) {
   HealthMonitor m;
   const common::Stamp t0 = common::Stamp::from_seconds(100.0);
-  auto r = m.report(t0, {{"estimation", 1000, 3, 2, {1.0f, 4.0f, 10}}}, {});
+  auto r = m.report(t0, {{"estimation", 1000, 3, 2, {1.0f, 3.0f, 4.0f, 10}}}, {});
   ASSERT_EQ(r.stages.size(), 1u);
   EXPECT_EQ(r.stages[0].rate_hz, 0.0f);  // nothing to compare with yet
   EXPECT_EQ(r.stages[0].queue_depth, 3u);

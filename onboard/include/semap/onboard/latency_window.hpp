@@ -8,11 +8,13 @@ namespace semap::onboard {
 
 struct LatencyPercentiles {
   float p50_ms = 0.0f;
+  float p95_ms = 0.0f;
   float p99_ms = 0.0f;
   std::size_t count = 0;  // latencies the figures come from (0: none recorded yet)
 };
 
-// The latencies of a stage's last `capacity` items, for the p50/p99 of the health report.
+// The latencies (or step durations) of a stage's last `capacity` items, for the percentiles of
+// the health report and the run summaries.
 // A stage thread records, the health thread reads; a mutex is cheap at stage rates (<= kHz).
 class LatencyWindow {
  public:

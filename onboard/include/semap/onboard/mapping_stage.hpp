@@ -57,6 +57,8 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   MappingStageStats stats() const;
   // Age of each cloud (its image's capture stamp) once it is in the map.
   const LatencyWindow& latency() const { return latency_; }
+  // Time each insert took.
+  const LatencyWindow& insert_time() const { return insert_time_; }
   // The map's blocks as the publisher sends them; safe from any thread. A paged-out block is
   // read from the checkpoint log; for_each_block lists the blocks in memory.
   const dds_idl::BlockSource& blocks() const { return *this; }
@@ -100,6 +102,7 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   std::unique_ptr<mapping::SemanticMap> full_map_;  // map() with a pager
   std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
   LatencyWindow latency_;
+  LatencyWindow insert_time_;
   StageThread<MappingStageStats> stage_;  // last: joined before the members it uses
 };
 

@@ -73,6 +73,10 @@ class PerceptionStage {
   PerceptionStageStats stats() const;
   // Age of each frame (its capture stamp) when its posed cloud goes to the mapping stage.
   const LatencyWindow& latency() const { return latency_; }
+  // Time each segmentation took, and each turning of a segmented frame into points
+  // (back-projecting depth, projecting a scan).
+  const LatencyWindow& segment_time() const { return segment_time_; }
+  const LatencyWindow& points_time() const { return points_time_; }
   std::uint32_t queue_depth() const;
   // The segmenter and depth source, for the log.
   std::string describe() const;
@@ -120,6 +124,8 @@ class PerceptionStage {
   std::deque<common::PointScan> scan_pending_;
   std::deque<BodyCloud> unposed_;
   LatencyWindow latency_;
+  LatencyWindow segment_time_;
+  LatencyWindow points_time_;
   StageThread<PerceptionStageStats> stage_;  // last: joined before the members it uses
 };
 

@@ -84,6 +84,8 @@ class Pipeline {
   bool perceiving() const { return perception_ != nullptr; }
   EstimationStageStats estimation() const { return estimation_->stats(); }
   std::optional<PerceptionStageStats> perception() const;
+  // Null when not perceiving.
+  const PerceptionStage* perception_stage() const { return perception_.get(); }
   MappingStageStats mapping() const { return mapping_->stats(); }
   const MappingStage& mapping_stage() const { return *mapping_; }
   const std::filesystem::path& checkpoint_path() const { return checkpoint_path_; }
