@@ -20,6 +20,7 @@
 #include "dataset_report.hpp"
 #include "kitti_raw_command.hpp"
 #include "kitti_semantic_command.hpp"
+#include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/perception/datasets/kitti_odometry.hpp"
@@ -42,6 +43,9 @@ struct Options {
   std::string map_config;
   std::string intrinsics;  // fx,fy,cx,cy
   std::optional<double> depth_scale;
+  // Every n-th depth pixel in u and v: at 640x480 a pixel spans millimetres, far below the
+  // 5 cm cells, so 2 builds the same map from a quarter of the points.
+  int pixel_stride = 2;
   std::string poses;  // kitti-odometry
   std::string calib;  // kitti-odometry
   onboard::DatasetSelection selection;
@@ -89,14 +93,16 @@ int map_classes(const Options& o) {
   return perception::load_model_card(o.segmenter_card).num_map_classes;
 }
 
-// The robot's configuration for an offline run: `map` unless --map names the robot's map:
-// section; no DDS, no checkpoint, no costmap; the segmenter the options choose.
+// The robot's configuration for an offline run: the map parameters `map`, overridden by the
+// keys of --map's map: section (or of the whole file when it has none); no DDS, no
+// checkpoint, no costmap; the segmenter the options choose, which sets the class count.
 onboard::OnboardConfig pipeline_config(const Options& o, const mapping::MapParams& map) {
   onboard::OnboardConfig c;
+  c.map.params = map;
   if (!o.map_config.empty()) {
-    c = onboard::load_onboard_config(o.map_config);
-  } else {
-    c.map.params = map;
+    const auto root = common::ConfigSection::load_file(o.map_config);
+    c.map.params =
+        mapping::map_params_from_config(root.has("map") ? root.section("map") : root, map);
   }
   c.map.params.num_classes = map_classes(o);
   c.map.palette = mapping::ClassPalette::defaults(c.map.params.num_classes);
@@ -190,6 +196,7 @@ int run_rgbd(const std::string& format, const Options& o) {
   onboard::OnboardConfig config = pipeline_config(o, rgbd_map());
   config.camera.intrinsics = *intrinsics;
   config.depth.source = onboard::DepthSource::kAligned;
+  config.depth.points.stride = o.pixel_stride;
   config.depth.depth_scale = static_cast<float>(1.0 / sequence.depth_units_per_metre);
   return run_pipeline(config, o, [&](const onboard::SensorRings& rings) {
     return std::make_unique<onboard::DatasetRig>(std::move(sequence), format + " " + o.dir,
@@ -255,7 +262,8 @@ int main(int argc, char** argv) {
     labels->excludes(none);
     command
         ->add_option("--map", o.map_config,
-                     "YAML file with the robot's map: section (default: the format's)")
+                     "YAML file whose map: section sets S-BKI parameters (resolution, ell, ...; "
+                     "default: the format's)")
         ->check(CLI::ExistingFile);
     command->add_option("--first", o.selection.first, "first frame (index)");
     command->add_option("--last", o.selection.last, "last frame (index)");
@@ -272,6 +280,10 @@ int main(int argc, char** argv) {
         ->add_option("--depth-scale", o.depth_scale,
                      "raw depth units per metre (default: 5000 TUM, 1000 Redwood)")
         ->check(CLI::PositiveNumber);
+    command
+        ->add_option("--pixel-stride", o.pixel_stride,
+                     "use every n-th depth pixel in u and v (default 2)")
+        ->check(CLI::Range(1, 16));
   };
   auto* tum = app.add_subcommand("tum", "TUM RGB-D: rgb.txt, depth.txt, groundtruth.txt");
   auto* redwood = app.add_subcommand(

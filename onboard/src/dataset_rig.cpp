@@ -116,11 +116,22 @@ void DatasetRig::problem(const std::filesystem::path& file, const std::string& w
 void DatasetRig::run(std::stop_token stop) {
   HandedOver handed;
   std::uint32_t sequence = 0;
-  for (const std::size_t index : selected_) {
-    if (stop.stop_requested()) break;
-    if (!hand_over(frames_[index], sequence++)) continue;
+  // Reads the next frame while the stages work on this one.
+  std::optional<Loaded> next;
+  auto position = selected_.begin();
+  const auto load_next = [&] {
+    next.reset();
+    while (!next && position != selected_.end() && !stop.stop_requested()) {
+      next = load(frames_[*position++]);
+    }
+  };
+  load_next();
+  while (next && !stop.stop_requested()) {
+    Loaded frame = std::move(*next);
+    hand_over(frame, sequence++);
     ++handed.frames;
     handed_.store(static_cast<std::size_t>(handed.frames), std::memory_order_release);
+    load_next();
     // Frame by frame: the rings drop their oldest entries when full, and the perception stage
     // passes over all but the newest frame it holds.
     while (taken_ && !taken_(handed) && !stop.stop_requested()) {
@@ -130,65 +141,71 @@ void DatasetRig::run(std::stop_token stop) {
   finished_.store(true, std::memory_order_release);
 }
 
-bool DatasetRig::hand_over(const DatasetFrame& frame, std::uint32_t sequence) {
+std::optional<DatasetRig::Loaded> DatasetRig::load(const DatasetFrame& frame) {
   // Scans are labelled with their image; a scan without one would wait for it forever.
   if (has_colour_ && !frame.scan.empty() && frame.colour.empty()) {
     problem(frame.scan, "no image to label the scan with");
-    return false;
+    return std::nullopt;
   }
-  cv::Mat colour;
+  Loaded loaded;
+  loaded.world_from_body = frame.world_from_body;
   if (!frame.colour.empty()) {
-    colour = cv::imread(frame.colour.string(), cv::IMREAD_COLOR);
-    if (colour.empty()) {
+    loaded.colour = cv::imread(frame.colour.string(), cv::IMREAD_COLOR);
+    if (loaded.colour.empty()) {
       problem(frame.colour, "cannot read the colour image");
-      return false;
+      return std::nullopt;
     }
   }
-  cv::Mat depth;
   if (!frame.depth.empty()) {
-    depth = cv::imread(frame.depth.string(), cv::IMREAD_UNCHANGED);
-    if (depth.empty()) {
+    loaded.depth = cv::imread(frame.depth.string(), cv::IMREAD_UNCHANGED);
+    if (loaded.depth.empty()) {
       problem(frame.depth, "cannot read the depth image");
-      return false;
+      return std::nullopt;
     }
-    if (depth.type() != CV_16UC1) {
+    if (loaded.depth.type() != CV_16UC1) {
       problem(frame.depth, "the depth image is not 16-bit single-channel");
-      return false;
+      return std::nullopt;
     }
-    if (depth.size() != colour.size()) {
+    if (loaded.depth.size() != loaded.colour.size()) {
       problem(frame.depth, "the depth image's size differs from the colour image's");
-      return false;
+      return std::nullopt;
     }
   }
-  common::PointScan scan;
   if (!frame.scan.empty()) {
     try {
-      for (const Eigen::Vector4f& p : perception::datasets::read_velodyne_bin(frame.scan)) {
-        scan.points.push_back(p.head<3>());
-      }
+      const auto points = perception::datasets::read_velodyne_bin(frame.scan);
+      common::PointScan scan;
+      scan.points.reserve(points.size());
+      for (const Eigen::Vector4f& p : points) scan.points.push_back(p.head<3>());
+      loaded.scan = std::move(scan);
     } catch (const perception::datasets::DatasetError& e) {
       problem(frame.scan, e.what());
-      return false;
+      return std::nullopt;
     }
   }
+  return loaded;
+}
+
+void DatasetRig::hand_over(Loaded& frame, std::uint32_t sequence) {
   const common::Stamp stamp = common::Stamp::now();
   estimation::StampedPose pose;
   pose.stamp = stamp;
   pose.orientation = Eigen::Quaterniond(frame.world_from_body.linear()).normalized();
   pose.position = frame.world_from_body.translation();
   rings_.poses.append(std::span(&pose, 1));
-  if (!depth.empty()) {
-    rings_.depth.try_push(drivers::to_frame(depth, common::PixelFormat::kZ16, stamp, sequence));
+  if (!frame.depth.empty()) {
+    rings_.depth.try_push(
+        drivers::to_frame(frame.depth, common::PixelFormat::kZ16, stamp, sequence));
   }
-  if (!frame.scan.empty()) {
-    scan.stamp = stamp;
-    scan.sequence = sequence;
-    rings_.scans.try_push(std::move(scan));
+  if (frame.scan) {
+    frame.scan->stamp = stamp;
+    frame.scan->sequence = sequence;
+    rings_.scans.try_push(std::move(*frame.scan));
   }
-  if (!colour.empty()) {
-    rings_.colour.try_push(drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+  if (!frame.colour.empty()) {
+    rings_.colour.try_push(
+        drivers::to_frame(frame.colour, common::PixelFormat::kBgr24, stamp, sequence));
   }
-  return true;
 }
 
 }  // namespace semap::onboard

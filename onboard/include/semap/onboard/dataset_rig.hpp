@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <limits>
 #include <mutex>
+#include <opencv2/core/mat.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -79,8 +81,19 @@ class DatasetRig final : public SensorRig {
   DatasetRig(std::vector<DatasetFrame> frames,
              std::vector<perception::datasets::InputProblem> reader_problems, std::string name,
              DatasetSelection selection, const SensorRings& rings);
+  // A frame's files, read.
+  struct Loaded {
+    cv::Mat colour;
+    cv::Mat depth;
+    std::optional<common::PointScan> scan;
+    Eigen::Isometry3d world_from_body;
+  };
+
   void run(std::stop_token stop);
-  bool hand_over(const DatasetFrame& frame, std::uint32_t sequence);
+  // Reads the frame's files; a file that cannot be used is named in problems(): nullopt.
+  std::optional<Loaded> load(const DatasetFrame& frame);
+  // Its pose into the history, then its frames into the rings, stamped now.
+  void hand_over(Loaded& frame, std::uint32_t sequence);
   void problem(const std::filesystem::path& file, const std::string& what);
 
   std::vector<DatasetFrame> frames_;

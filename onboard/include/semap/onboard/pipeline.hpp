@@ -105,7 +105,8 @@ class Pipeline {
   const OnboardConfig& config() const { return config_; }
 
  private:
-  // Fast replay: true once the stages have taken all that the rig handed over.
+  // Fast replay: true once the stages have taken all that the rig handed over, the mapping
+  // stage allowed to be one cloud behind (it inserts one while perception makes the next).
   bool has_taken(const HandedOver& handed) const;
   Rings rings() const;
 
