@@ -32,7 +32,7 @@ std::size_t write_dataset_outputs(const std::filesystem::path& out, onboard::Pip
   const std::size_t unreadable = rig.selected() - rig.handed_over();
   const std::size_t not_mapped = rig.selected() - static_cast<std::size_t>(m.scans);
   const std::size_t skipped_by_reader = problems.size() - unreadable;
-  const onboard::LatencyWindow none;
+  const common::LatencyWindow none;
   const auto* stage = pipeline.perception_stage();
   const auto segment = (stage ? stage->segment_time() : none).percentiles();
   const auto points = (stage ? stage->points_time() : none).percentiles();

@@ -31,7 +31,8 @@ void print_health(const sd::HealthReport& h) {
     std::cout << " driver " << d.name << " frames " << d.frames << " bad " << d.bad_frames
               << " dropped " << d.dropped << " reconnects " << d.reconnects << " bus_off "
               << d.bus_off << " error_passive " << d.error_passive << " bus_restarts "
-              << d.bus_restarts << " |";
+              << d.bus_restarts << " wakeup_p99 " << d.wakeup_p99_ms << " wakeup_max "
+              << d.wakeup_max_ms << " |";
   }
   std::cout << std::endl;
 }

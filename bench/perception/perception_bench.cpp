@@ -159,7 +159,7 @@ void per_stage(const Options& o, const onboard::OnboardConfig& config,
 
 struct SteadyState {
   double mapped_hz = 0, cpu_cores = 0;
-  onboard::LatencyPercentiles latency;
+  common::LatencyPercentiles latency;
   std::uint64_t frames = 0, clouds = 0, skipped = 0;  // the perception stage's
 };
 

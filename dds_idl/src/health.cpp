@@ -11,7 +11,8 @@ HealthMessage::HealthMessage(const HealthReport& r, const std::string& frame_id)
   }
   for (const auto& d : r.drivers) {
     drivers_.push_back({const_cast<char*>(d.name.c_str()), d.frames, d.bad_frames, d.dropped,
-                        d.reconnects, d.bus_off, d.error_passive, d.bus_restarts});
+                        d.reconnects, d.bus_off, d.error_passive, d.bus_restarts, d.wakeup_p50_ms,
+                        d.wakeup_p99_ms, d.wakeup_max_ms});
   }
   msg_.header_.stamp_ = to_msg_time(r.stamp);
   msg_.header_.frame_id_ = const_cast<char*>(frame_id.c_str());
@@ -32,7 +33,8 @@ HealthReport from_msg(const msg::Health& m) {
   for (std::uint32_t i = 0; i < m.drivers_._length; ++i) {
     const auto& d = m.drivers_._buffer[i];
     r.drivers.push_back({d.name_ ? d.name_ : "", d.frames_, d.bad_frames_, d.dropped_,
-                         d.reconnects_, d.bus_off_, d.error_passive_, d.bus_restarts_});
+                         d.reconnects_, d.bus_off_, d.error_passive_, d.bus_restarts_,
+                         d.wakeup_p50_ms_, d.wakeup_p99_ms_, d.wakeup_max_ms_});
   }
   return r;
 }

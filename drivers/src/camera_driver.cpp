@@ -11,7 +11,7 @@
 namespace semap::drivers {
 
 CameraDriver::CameraDriver(CameraConfig config, common::SpscRing<common::ImageFrame>& ring)
-    : DriverRunner("camera", config.backoff, config.realtime_priority),
+    : DriverRunner("camera", config.backoff, config.realtime_priority, config.cpus),
       config_(std::move(config)),
       ring_(ring),
       jpeg_(std::make_unique<JpegDecoder>()) {}
@@ -69,6 +69,7 @@ void CameraDriver::service_device(std::stop_token /*stop*/) {
     }
     return;
   }
+  if (raw.kernel_stamped) record_wakeup(raw.stamp);
   last_frame_time_ = now;
   counters().add_bytes(raw.bytes.size());
   if (have_sequence_ && raw.sequence > last_sequence_ + 1) {

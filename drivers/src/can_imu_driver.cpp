@@ -11,7 +11,7 @@ constexpr std::chrono::milliseconds kStatePollInterval{250};
 }  // namespace
 
 CanImuDriver::CanImuDriver(CanImuConfig config, common::SpscRing<common::ImuSample>& ring)
-    : DriverRunner("can_imu", config.backoff, config.realtime_priority),
+    : DriverRunner("can_imu", config.backoff, config.realtime_priority, config.cpus),
       config_(std::move(config)),
       ring_(ring),
       decoder_(config_.decoder),
@@ -54,6 +54,7 @@ void CanImuDriver::service_device(std::stop_token /*stop*/) {
       counters().add_input_drop(rx.kernel_drops - socket_drops_);
       socket_drops_ = rx.kernel_drops;
     }
+    if (rx.kernel_stamped) record_wakeup(rx.stamp);
     if (auto sample = decoder_.push(rx.frame, rx.stamp)) deliver(ring_, std::move(*sample));
   }
   watch_controller();

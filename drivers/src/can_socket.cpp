@@ -140,6 +140,7 @@ CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {
     return CanRead::kTimeout;  // remote frame: not part of any protocol we decode
   }
   frame.stamp = common::Stamp::now();
+  frame.kernel_stamped = false;
   frame.realtime_ns = clock_.to_realtime(frame.stamp);
   for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPING) {
@@ -148,6 +149,7 @@ CanRead CanSocket::receive(int timeout_ms, CanRxFrame& frame) {
       if (ts.ts[0].tv_sec != 0 || ts.ts[0].tv_nsec != 0) {
         frame.realtime_ns = common::Stamp::from_timespec(ts.ts[0]).ns;
         frame.stamp = clock_.to_monotonic(frame.realtime_ns);
+        frame.kernel_stamped = true;
       }
     } else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
       std::memcpy(&frame.kernel_drops, CMSG_DATA(c), sizeof(frame.kernel_drops));

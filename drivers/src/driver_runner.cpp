@@ -34,10 +34,12 @@ const char* to_string(DriverState state) {
   return "unknown";
 }
 
-DriverRunner::DriverRunner(std::string name, BackoffConfig backoff, int realtime_priority)
+DriverRunner::DriverRunner(std::string name, BackoffConfig backoff, int realtime_priority,
+                           std::vector<int> cpus)
     : name_(std::move(name)),
       backoff_config_(backoff),
       realtime_priority_(realtime_priority),
+      cpus_(std::move(cpus)),
       log_(common::logger(name_)) {
   Backoff check(backoff);  // validates the configuration before any thread starts
   if (realtime_priority < 0 || realtime_priority > kMaxRealtimePriority) {
@@ -47,6 +49,12 @@ DriverRunner::DriverRunner(std::string name, BackoffConfig backoff, int realtime
 }
 
 DriverRunner::~DriverRunner() { stop(); }
+
+DriverStats DriverRunner::stats() const {
+  DriverStats s = counters_.snapshot();
+  s.wakeup = wakeup_.percentiles();
+  return s;
+}
 
 void DriverRunner::start() {
   if (thread_.joinable()) return;
@@ -86,6 +94,14 @@ void DriverRunner::run(std::stop_token stop) {
       log_->info("thread at SCHED_FIFO priority {}", realtime_priority_);
     } else {
       report(refused + "; running at normal scheduling", false);
+    }
+  }
+  if (!cpus_.empty()) {
+    const std::string refused = set_cpu_affinity(cpus_);
+    if (refused.empty()) {
+      log_->info("thread pinned to {} CPU(s)", cpus_.size());
+    } else {
+      report(refused + "; running where the kernel places it", false);
     }
   }
   Backoff backoff(backoff_config_);

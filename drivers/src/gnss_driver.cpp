@@ -19,7 +19,7 @@ constexpr std::size_t kReadChunk = 512;
 }  // namespace
 
 GnssDriver::GnssDriver(GnssConfig config, common::SpscRing<common::GnssFix>& ring)
-    : DriverRunner("gnss", config.backoff, config.realtime_priority),
+    : DriverRunner("gnss", config.backoff, config.realtime_priority, config.cpus),
       config_(std::move(config)),
       ring_(ring),
       buffer_(kReadChunk) {

@@ -223,11 +223,13 @@ bool V4l2Device::dequeue(int timeout_ms, V4l2Frame& frame) {
   frame.bytes = {static_cast<const std::uint8_t*>(b.start),
                  std::min<std::size_t>(buf.bytesused, b.length)};
   frame.stamp = common::Stamp::from_timeval(buf.timestamp);
+  frame.kernel_stamped = true;
   frame.sequence = buf.sequence;
   frame.error = (buf.flags & V4L2_BUF_FLAG_ERROR) != 0;
   if ((buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) != V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC) {
     // Only monotonic timestamps share the pipeline's clock; fall back to the dequeue time.
     frame.stamp = common::Stamp::now();
+    frame.kernel_stamped = false;
   }
   return true;
 }

@@ -37,7 +37,10 @@ dds_idl::DriverCountersData driver_health(const std::string& name, const drivers
           s.reconnects,
           s.bus_off,
           s.error_passive,
-          s.bus_restarts};
+          s.bus_restarts,
+          s.wakeup.p50_ms,
+          s.wakeup.p99_ms,
+          s.wakeup.max_ms};
 }
 
 }  // namespace semap::onboard

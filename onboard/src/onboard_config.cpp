@@ -234,6 +234,9 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
   }
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);
+  const auto realtime = root.section_or_empty("realtime");
+  c.realtime.lock_memory = realtime.get<bool>("lock_memory", c.realtime.lock_memory);
+  realtime.finish();
   if (root.has("costmap")) {
     const auto costmap = root.section("costmap");
     CostmapConfig cc;

@@ -8,6 +8,7 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/common/process_usage.hpp"
+#include "semap/drivers/realtime.hpp"
 #include "semap/mapping/smap_io.hpp"
 #include "semap/onboard/run_summary.hpp"
 #include "semap/onboard/segmenter_factory.hpp"
@@ -116,6 +117,15 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
 Pipeline::~Pipeline() { stop(); }
 
 void Pipeline::start() {
+  if (config_.realtime.lock_memory) {
+    memory_lock_ = drivers::lock_memory();
+    if (memory_lock_.empty()) {
+      memory_lock_ = "memory locked (mlockall)";
+      common::logger("onboard")->info("{}", memory_lock_);
+    } else {
+      common::logger("onboard")->error("{}; running with pageable memory", memory_lock_);
+    }
+  }
   if (perception_ && !observers_.empty()) {
     perception_->set_observer([this](std::uint32_t sequence, common::Stamp stamp,
                                      const cv::Mat& bgr, const perception::Segmentation& s) {
@@ -226,6 +236,7 @@ std::vector<std::string> Pipeline::summary() const {
   ring_summary(rings(), lines);
   lines.push_back(
       fmt::format("cpu              : {:.2f} cores over {:.1f} s", cpu_cores_, wall_s_));
+  if (!memory_lock_.empty()) lines.push_back("realtime         : " + memory_lock_);
   return lines;
 }
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <thread>
+#include <vector>
 
 #include "semap/drivers/driver_error.hpp"
 #include "semap/drivers/realtime.hpp"
@@ -148,12 +150,14 @@ TEST_F(DriverRunnerTest, StopIsPromptDuringALongBackoff) {
 // Records the scheduling its thread runs with.
 class SchedulingDriver : public DriverRunner {
  public:
-  explicit SchedulingDriver(int realtime_priority)
-      : DriverRunner("scheduling_driver", {}, realtime_priority) {}
+  explicit SchedulingDriver(int realtime_priority, std::vector<int> cpus = {})
+      : DriverRunner("scheduling_driver", {}, realtime_priority, std::move(cpus)) {}
   ~SchedulingDriver() override { stop(); }
 
   std::atomic<int> policy{-1};
   std::atomic<int> priority{-1};
+  std::atomic<int> cpu_count{-1};
+  std::atomic<bool> on_cpu0{false};
 
  protected:
   void open_device() override {}
@@ -162,6 +166,13 @@ class SchedulingDriver : public DriverRunner {
     sched_param param{};
     ::pthread_getschedparam(::pthread_self(), &p, &param);
     priority.store(param.sched_priority);
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    ::pthread_getaffinity_np(::pthread_self(), sizeof(set), &set);
+    on_cpu0.store(CPU_ISSET(0, &set));
+    cpu_count.store(CPU_COUNT(&set));
+    // Data the "kernel" stamped 3 ms ago: the lateness the driver reports.
+    record_wakeup(common::Stamp::now() + (-0.003));
     policy.store(p);
     std::this_thread::sleep_for(1ms);
   }
@@ -192,6 +203,48 @@ TEST(DriverRealtime, NormalSchedulingUnlessAsked) {
   ASSERT_TRUE(wait_until([&] { return driver.policy.load() >= 0; }, 5s));
   EXPECT_EQ(driver.policy.load(), SCHED_OTHER);
   EXPECT_EQ(driver.realtime_priority(), 0);
+}
+
+TEST(DriverRealtime, ThreadRunsOnTheCpusItIsPinnedTo) {
+  SchedulingDriver pinned(0, {0});
+  pinned.start();
+  ASSERT_TRUE(wait_until([&] { return pinned.policy.load() >= 0; }, 5s));
+  EXPECT_EQ(pinned.cpu_count.load(), 1);
+  EXPECT_TRUE(pinned.on_cpu0.load());
+  EXPECT_EQ(pinned.last_error(), "");
+  // A CPU the machine does not have: reported, and the thread runs on where it was.
+  SchedulingDriver missing(0, {1023});
+  missing.start();
+  ASSERT_TRUE(wait_until([&] { return missing.policy.load() >= 0; }, 5s));
+  EXPECT_NE(missing.last_error().find("CPU affinity {1023} refused"), std::string::npos)
+      << missing.last_error();
+  EXPECT_EQ(missing.state(), DriverState::kRunning);
+  EXPECT_EQ(set_cpu_affinity(std::vector<int>{-1}), "CPU -1 is outside the CPU set");
+}
+
+TEST(DriverRealtime, ReportsTheWakeUpLatenessOfItsThread) {
+  SchedulingDriver driver(0);
+  driver.start();
+  ASSERT_TRUE(wait_until([&] { return driver.stats().wakeup.count >= 10; }, 5s));
+  const auto wakeup = driver.stats().wakeup;
+  EXPECT_GE(wakeup.p50_ms, 3.0f);
+  EXPECT_LT(wakeup.p50_ms, 1000.0f);
+  EXPECT_GE(wakeup.max_ms, wakeup.p99_ms);
+}
+
+TEST(DriverRealtime, LocksMemoryOrSaysWhyNot) {
+  const std::string refused = lock_memory();
+  std::ifstream status("/proc/self/status");
+  std::string line, locked;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmLck:", 0) == 0) locked = line;
+  }
+  if (refused.empty()) {
+    EXPECT_NE(locked, "VmLck:\t       0 kB") << "mlockall succeeded but nothing is locked";
+    ::munlockall();
+  } else {
+    EXPECT_NE(refused.find("mlockall refused"), std::string::npos) << refused;
+  }
 }
 
 TEST(DriverRealtime, RefusalsNameThePriorityAndTheReason) {

@@ -29,6 +29,11 @@ struct DriverCountersData {
   std::uint64_t bus_off = 0;
   std::uint64_t error_passive = 0;
   std::uint64_t bus_restarts = 0;
+  // Wake-up lateness of the driver's thread: when it handled the data minus the kernel's stamp
+  // of its arrival (0 for devices without kernel stamps).
+  float wakeup_p50_ms = 0.0f;
+  float wakeup_p99_ms = 0.0f;
+  float wakeup_max_ms = 0.0f;
 };
 
 struct HealthReport {

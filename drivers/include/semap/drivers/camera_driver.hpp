@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
@@ -29,6 +30,7 @@ struct CameraConfig {
   std::chrono::milliseconds stall_timeout{2000};
   BackoffConfig backoff;
   int realtime_priority = 0;  // SCHED_FIFO 1..99 for the driver's thread; 0: normal
+  std::vector<int> cpus;      // CPUs the driver's thread is pinned to; empty: any
 };
 
 // What the device agreed to; valid once state() is kRunning.

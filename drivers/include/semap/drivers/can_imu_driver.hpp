@@ -6,6 +6,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
@@ -28,6 +29,7 @@ struct CanImuConfig {
   bool restart_bus_off = true;
   BackoffConfig backoff;
   int realtime_priority = 0;  // SCHED_FIFO 1..99 for the driver's thread; 0: normal
+  std::vector<int> cpus;      // CPUs the driver's thread is pinned to; empty: any
 };
 
 // SocketCAN IMU thread: a CAN_RAW socket with kernel filters for the profile's identifiers,

@@ -18,6 +18,7 @@ struct CanRxFrame {
   SemapCanFrame frame{};
   CanErrorReport error;          // what an error frame says (kError only)
   common::Stamp stamp;           // kernel RX software timestamp, mapped onto CLOCK_MONOTONIC
+  bool kernel_stamped = false;   // false: the kernel gave no stamp, `stamp` is the read time
   std::int64_t realtime_ns = 0;  // the same instant on CLOCK_REALTIME, as candump logs it
   // Frames the kernel dropped on this socket so far because its queue was full (SO_RXQ_OVFL).
   std::uint32_t kernel_drops = 0;

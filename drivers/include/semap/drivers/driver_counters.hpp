@@ -3,6 +3,8 @@
 #include <atomic>
 #include <cstdint>
 
+#include "semap/common/latency_window.hpp"
+
 namespace semap::drivers {
 
 // A consistent-enough copy of a driver's counters for reporting.
@@ -18,6 +20,10 @@ struct DriverStats {
   std::uint64_t bus_off = 0;            // CAN: times the controller went bus-off
   std::uint64_t error_passive = 0;      // CAN: times the controller went error-passive
   std::uint64_t bus_restarts = 0;       // CAN: recoveries from bus-off (restarted, back on the bus)
+  // Wake-up lateness of the driver thread: when it handled the data minus the kernel's stamp of
+  // the data's arrival (CAN RX, V4L2 buffer), over its last 1024 messages. Empty (count 0) for
+  // devices without kernel stamps (serial).
+  common::LatencyPercentiles wakeup;
 };
 
 // Written by the driver thread only, read from any thread. Single writer, so a relaxed load

@@ -8,8 +8,11 @@
 #include <stop_token>
 #include <string>
 #include <thread>
+#include <vector>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/common/spsc_ring.hpp"
+#include "semap/common/stamp.hpp"
 #include "semap/drivers/backoff.hpp"
 #include "semap/drivers/driver_counters.hpp"
 
@@ -29,10 +32,12 @@ const char* to_string(DriverState state);
 // on its own thread until stop(). service_device() must return within a bounded time (it polls
 // with a timeout) so that stop() is prompt. Derived destructors must call stop() first, since
 // the thread calls their virtual functions. With a realtime priority the thread runs at
-// SCHED_FIFO (realtime.hpp); a refusal is reported and the thread runs on at normal scheduling.
+// SCHED_FIFO, with `cpus` it is pinned to those CPUs (realtime.hpp); a refusal is reported and
+// the thread runs on as the kernel placed it.
 class DriverRunner {
  public:
-  DriverRunner(std::string name, BackoffConfig backoff, int realtime_priority = 0);
+  DriverRunner(std::string name, BackoffConfig backoff, int realtime_priority = 0,
+               std::vector<int> cpus = {});
   virtual ~DriverRunner();
   DriverRunner(const DriverRunner&) = delete;
   DriverRunner& operator=(const DriverRunner&) = delete;
@@ -41,7 +46,7 @@ class DriverRunner {
   void stop();  // idempotent; joins the thread and closes the device
 
   DriverState state() const { return state_.load(std::memory_order_acquire); }
-  DriverStats stats() const { return counters_.snapshot(); }
+  DriverStats stats() const;
   std::string last_error() const;
   // Why the last running connection ended (device lost), which later failed reopen attempts do
   // not overwrite; empty while the device has never been lost.
@@ -67,6 +72,11 @@ class DriverRunner {
     counters_.add_frame();
   }
 
+  // The thread handles data the kernel stamped at `arrival` (CLOCK_MONOTONIC): its lateness
+  // goes into stats().wakeup.
+  void record_wakeup(common::Stamp arrival) {
+    wakeup_.record(common::seconds_between(common::Stamp::now(), arrival));
+  }
   // Logs a warning and keeps it as last_error() (and as last_loss() when `lost`).
   void report(const std::string& message, bool lost);
   DriverCounters& counters() { return counters_; }
@@ -78,9 +88,11 @@ class DriverRunner {
   std::string name_;
   BackoffConfig backoff_config_;
   int realtime_priority_;
+  std::vector<int> cpus_;
   std::atomic<int> realtime_applied_{0};
   std::shared_ptr<spdlog::logger> log_;
   DriverCounters counters_;
+  common::LatencyWindow wakeup_;
   std::atomic<DriverState> state_{DriverState::kStopped};
   std::atomic<std::uint64_t> failures_{0};
   mutable std::mutex error_mutex_;

@@ -19,6 +19,7 @@ struct GnssConfig {
   int poll_timeout_ms = 100;
   BackoffConfig backoff;
   int realtime_priority = 0;  // SCHED_FIFO 1..99 for the driver's thread; 0: normal
+  std::vector<int> cpus;      // CPUs the driver's thread is pinned to; empty: any
 };
 
 // Serial GNSS thread: termios raw 8N1, poll()-based reads, NMEA and UBX (interleaved) through

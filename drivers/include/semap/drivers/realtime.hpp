@@ -1,5 +1,6 @@
 #pragma once
 
+#include <span>
 #include <string>
 
 namespace semap::drivers {
@@ -13,5 +14,15 @@ inline constexpr int kMaxRealtimePriority = 99;
 // Puts the calling thread at SCHED_FIFO `priority`. Returns an empty string, or why the kernel
 // refused (the thread then keeps its scheduling).
 std::string set_realtime_priority(int priority);
+
+// Pins the calling thread to `cpus` (empty: no change). Keeping a driver on its own core keeps
+// other threads' cache and scheduling noise off its wake-ups. Returns an empty string, or why
+// the kernel refused (a CPU the machine does not have, a cpuset that excludes it).
+std::string set_cpu_affinity(std::span<const int> cpus);
+
+// Locks the process's pages in RAM, now and future (mlockall), so no page fault stalls a
+// driver or stage thread on a robot under memory pressure. Returns an empty string, or why it
+// was refused (RLIMIT_MEMLOCK too small; systemd: LimitMEMLOCK=infinity).
+std::string lock_memory();
 
 }  // namespace semap::drivers

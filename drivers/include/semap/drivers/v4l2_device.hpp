@@ -39,7 +39,8 @@ struct V4l2Format {
 // A dequeued buffer, valid until the next dequeue() or stop(); the device requeues it then.
 struct V4l2Frame {
   std::span<const std::uint8_t> bytes;
-  common::Stamp stamp;  // driver timestamp, CLOCK_MONOTONIC
+  common::Stamp stamp;          // driver timestamp, CLOCK_MONOTONIC
+  bool kernel_stamped = false;  // `stamp` is the driver's; false: the dequeue time
   std::uint32_t sequence = 0;
   bool error = false;  // V4L2_BUF_FLAG_ERROR: the driver says the data may be corrupt
 };

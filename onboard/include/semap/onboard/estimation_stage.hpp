@@ -8,10 +8,10 @@
 #include <thread>
 #include <vector>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/estimation/estimator.hpp"
-#include "semap/onboard/latency_window.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
 #include "semap/onboard/stage_thread.hpp"
@@ -68,7 +68,7 @@ class EstimationStage {
   void stop();
   EstimationStageStats stats() const;
   // Age of each IMU sample when the filter has taken it (driver stamp to filter).
-  const LatencyWindow& imu_latency() const { return imu_latency_; }
+  const common::LatencyWindow& imu_latency() const { return imu_latency_; }
 
  private:
   void run(std::stop_token stop);
@@ -88,7 +88,7 @@ class EstimationStage {
   common::Stamp next_heading_check_;
   common::ImuSample last_imu_;
   common::Stamp next_pose_publish_;
-  LatencyWindow imu_latency_;
+  common::LatencyWindow imu_latency_;
   StageThread<EstimationStageStats> stage_;  // last: joined before the members it uses
 };
 

@@ -5,10 +5,10 @@
 #include <unordered_map>
 #include <vector>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/common/stamp.hpp"
 #include "semap/dds_idl/health.hpp"
 #include "semap/drivers/driver_counters.hpp"
-#include "semap/onboard/latency_window.hpp"
 
 namespace semap::onboard {
 
@@ -19,7 +19,7 @@ struct StageFigures {
   std::uint64_t items = 0;
   std::uint32_t queue_depth = 0;
   std::uint64_t drops = 0;
-  LatencyPercentiles latency;
+  common::LatencyPercentiles latency;
 };
 
 // Turns stage and driver figures into semap_msgs/Health content; a stage's rate is the

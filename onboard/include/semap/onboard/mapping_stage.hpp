@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/dds_idl/block_snapshot.hpp"
@@ -17,7 +18,6 @@
 #include "semap/mapping/map_checkpoint.hpp"
 #include "semap/mapping/semantic_map.hpp"
 #include "semap/onboard/costmap_output.hpp"
-#include "semap/onboard/latency_window.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/stage_thread.hpp"
 
@@ -56,9 +56,9 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   void stop();
   MappingStageStats stats() const;
   // Age of each cloud (its image's capture stamp) once it is in the map.
-  const LatencyWindow& latency() const { return latency_; }
+  const common::LatencyWindow& latency() const { return latency_; }
   // Time each insert took.
-  const LatencyWindow& insert_time() const { return insert_time_; }
+  const common::LatencyWindow& insert_time() const { return insert_time_; }
   // The map's blocks as the publisher sends them; safe from any thread. A paged-out block is
   // read from the checkpoint log; for_each_block lists the blocks in memory.
   const dds_idl::BlockSource& blocks() const { return *this; }
@@ -101,8 +101,8 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   std::unique_ptr<mapping::MapPager> pager_;
   std::unique_ptr<mapping::SemanticMap> full_map_;  // map() with a pager
   std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
-  LatencyWindow latency_;
-  LatencyWindow insert_time_;
+  common::LatencyWindow latency_;
+  common::LatencyWindow insert_time_;
   StageThread<MappingStageStats> stage_;  // last: joined before the members it uses
 };
 

@@ -94,6 +94,14 @@ struct MappingConfig {
   double start_heading_sigma_deg = 3.0;
 };
 
+// realtime: process-wide real-time practice (each driver's thread has its own
+// realtime_priority and cpus in its section).
+struct RealtimeConfig {
+  // mlockall at start: no page fault stalls a thread later; a refusal is logged and reported in
+  // the summary, and the robot runs on.
+  bool lock_memory = false;
+};
+
 struct OnboardConfig {
   RigConfig rig;
   ImuSourceConfig imu;
@@ -105,6 +113,7 @@ struct OnboardConfig {
   MappingConfig map;
   std::optional<CostmapConfig> costmap;  // the `costmap:` section; published over DDS
   DdsConfig dds;
+  RealtimeConfig realtime;
   std::string log_level = "info";
 };
 

@@ -6,10 +6,10 @@
 #include <mutex>
 #include <thread>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/drivers/jpeg_decoder.hpp"
-#include "semap/onboard/latency_window.hpp"
 #include "semap/onboard/perception_config.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
 #include "semap/onboard/stage_thread.hpp"
@@ -72,11 +72,11 @@ class PerceptionStage {
   void stop();
   PerceptionStageStats stats() const;
   // Age of each frame (its capture stamp) when its posed cloud goes to the mapping stage.
-  const LatencyWindow& latency() const { return latency_; }
+  const common::LatencyWindow& latency() const { return latency_; }
   // Time each segmentation took, and each turning of a segmented frame into points
   // (back-projecting depth, projecting a scan).
-  const LatencyWindow& segment_time() const { return segment_time_; }
-  const LatencyWindow& points_time() const { return points_time_; }
+  const common::LatencyWindow& segment_time() const { return segment_time_; }
+  const common::LatencyWindow& points_time() const { return points_time_; }
   std::uint32_t queue_depth() const;
   // The segmenter and depth source, for the log.
   std::string describe() const;
@@ -123,9 +123,9 @@ class PerceptionStage {
   std::deque<common::ImageFrame> depth_pending_;
   std::deque<common::PointScan> scan_pending_;
   std::deque<BodyCloud> unposed_;
-  LatencyWindow latency_;
-  LatencyWindow segment_time_;
-  LatencyWindow points_time_;
+  common::LatencyWindow latency_;
+  common::LatencyWindow segment_time_;
+  common::LatencyWindow points_time_;
   StageThread<PerceptionStageStats> stage_;  // last: joined before the members it uses
 };
 

@@ -130,6 +130,7 @@ class Pipeline {
   Progress progress_;
   common::Stamp started_;
   double cpu_at_start_s_ = 0.0;
+  std::string memory_lock_;  // realtime.lock_memory: what mlockall did
   double cpu_cores_ = 0.0;
   double wall_s_ = 0.0;
   common::Stamp next_health_;

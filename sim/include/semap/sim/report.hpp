@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/mapping/confusion_matrix.hpp"
 #include "semap/onboard/estimation_stage.hpp"
-#include "semap/onboard/latency_window.hpp"
 #include "semap/onboard/pipeline.hpp"
 #include "semap/perception/segmentation.hpp"
 #include "semap/perception/sim_classes.hpp"
@@ -56,7 +56,7 @@ struct RunFigures {
   std::optional<double> pose_rmse_m;
   std::uint64_t frames_captured = 0;  // rendered by the rig's camera
   std::uint64_t frames_mapped = 0;    // clouds inserted into the map
-  onboard::LatencyPercentiles latency_frame_to_map;
+  common::LatencyPercentiles latency_frame_to_map;
   std::vector<std::pair<std::string, std::uint64_t>> ring_drops;
   double cpu_cores_used = 0.0;
 };

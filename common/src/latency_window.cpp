@@ -1,10 +1,10 @@
-#include "semap/onboard/latency_window.hpp"
+#include "semap/common/latency_window.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-namespace semap::onboard {
+namespace semap::common {
 
 LatencyWindow::LatencyWindow(std::size_t capacity) : capacity_(capacity) {
   if (capacity_ == 0) throw std::invalid_argument("LatencyWindow: capacity must be > 0");
@@ -41,7 +41,8 @@ LatencyPercentiles LatencyWindow::percentiles() const {
   p.p50_ms = rank(0.50);
   p.p95_ms = rank(0.95);
   p.p99_ms = rank(0.99);
+  p.max_ms = *std::max_element(v.begin(), v.end());
   return p;
 }
 
-}  // namespace semap::onboard
+}  // namespace semap::common

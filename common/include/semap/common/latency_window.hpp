@@ -4,12 +4,13 @@
 #include <mutex>
 #include <vector>
 
-namespace semap::onboard {
+namespace semap::common {
 
 struct LatencyPercentiles {
   float p50_ms = 0.0f;
   float p95_ms = 0.0f;
   float p99_ms = 0.0f;
+  float max_ms = 0.0f;
   std::size_t count = 0;  // latencies the figures come from (0: none recorded yet)
 };
 
@@ -30,4 +31,4 @@ class LatencyWindow {
   std::size_t next_ = 0;
 };
 
-}  // namespace semap::onboard
+}  // namespace semap::common
