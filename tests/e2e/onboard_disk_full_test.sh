@@ -3,8 +3,10 @@
 # robot checkpoints every second while a planner-side listener follows its health over DDS:
 #
 #   ulimit  the process runs under a 4 MiB file-size limit (ulimit -f; semap-onboard ignores
-#           SIGXFSZ, so writes fail with EFBIG): the checkpoint log reaches it a few seconds
-#           into mapping, and the map saved at SIGTERM does not fit either.
+#           SIGXFSZ, so writes fail with EFBIG) and records its sensor streams (--record): the
+#           camera log reaches the limit at once, the checkpoint log a few seconds into mapping,
+#           and the map saved at SIGTERM does not fit either. The recording must replay to its
+#           end without damage.
 #   tmpfs   (root, mount permitted; else skipped with exit 77) the map lives on a 32 MiB tmpfs
 #           that a filler file leaves 3 MiB of: checkpoints fail with ENOSPC; then the filler
 #           is deleted, writing must resume and the map saved at SIGTERM fits.
@@ -59,7 +61,8 @@ if [[ $mode == tmpfs ]]; then
 else
   (
     ulimit -f 4096 # KiB: 4 MiB per file
-    exec "$onboard" --config "$work/sim.yaml" --duration 120 --domain "$domain"
+    exec "$onboard" --config "$work/sim.yaml" --duration 120 --domain "$domain" \
+      --record "$disk/rec"
   ) >"$work/run.log" 2>&1 &
 fi
 pid=$!
@@ -125,7 +128,7 @@ scans=$(grep -o "^mapping          : [0-9]* scans" "$work/run.log" | grep -o "[0
   grep -o "[0-9]*")
 
 # Health over DDS: the failures while estimation, mapping and the map publisher kept going.
-failing_reports=$(grep "writer map_checkpoint .* failing 1 error '.*$errno_text'" \
+failing_reports=$(grep "writer map_checkpoint [^|]* failing 1 error '[^']*$errno_text'" \
   "$work/listener.log" || true)
 [[ -n $failing_reports ]] || {
   tail -5 "$work/listener.log"
@@ -142,13 +145,32 @@ say "$failures write failures, $(echo "$failing_reports" | wc -l) health reports
 if [[ $mode == tmpfs ]]; then
   grep -q "checkpoint fails : .* writing again at exit" "$work/run.log" ||
     fail "the summary does not say writing resumed"
-  grep -q "writer map_checkpoint .* failing 0 " <(grep -A1000 "failing 1" "$work/listener.log") ||
+  grep -q "writer map_checkpoint [^|]* failing 0 " <(grep -A1000 "failing 1" "$work/listener.log") ||
     fail "no health report after the recovery"
   [[ $committed -eq $scans ]] || fail "the log holds scan $committed of $scans after recovery"
 else
   [[ $scans -gt $((committed + 10)) ]] || fail "mapping stopped with the checkpoint ($scans scans)"
   size=$(stat -c %s "$disk/map.smap.log")
   [[ $size -le $((4096 * 1024)) ]] || fail "the log is past the limit ($size bytes)"
+  # The recorder: counted, named, in health; its files whole and replayable to their end.
+  grep -Eq "recording        : $disk/rec: .* [1-9][0-9]* write failures \(still failing at exit; last error: $disk/rec/(colour|depth).log: write: $errno_text\)" \
+    "$work/run.log" || fail "the recording's failures are not in the summary"
+  grep -q "\[recorder\] \[error\] recording: $disk/rec/colour.log: write: $errno_text" \
+    "$work/run.log" || fail "the recording's failure is not logged"
+  grep -q "writer recorder [^|]* failing 1 error '[^']*$errno_text'" "$work/listener.log" ||
+    fail "no health report with the recorder failing"
+  "$onboard" --replay "$disk/rec" --pace fast --save "$work/replay.smap" --domain "$domain" \
+    >"$work/replay.log" 2>&1 || true
+  grep -q "^replay           : [1-9][0-9]* CAN frames" "$work/replay.log" || {
+    cat "$work/replay.log"
+    fail "the recording does not replay"
+  }
+  grep -q "^replay           : .*damaged" "$work/replay.log" && {
+    grep "^replay  " "$work/replay.log"
+    fail "the recording has a torn record"
+  }
+  say "recording: $(grep -o "[0-9]* write failures (still failing" "$work/run.log"), replayed:" \
+    "$(grep "^replay  " "$work/replay.log")"
 fi
 
 # The checkpoint log: no torn record, and --resume loads its last checkpoint.
