@@ -18,8 +18,8 @@ namespace sd = semap::dds_idl;
 
 namespace {
 
-// One line per Health sample, "health: <stage> rate .. | driver <name> frames ..", for people
-// and for the end-to-end test to parse.
+// One line per Health sample, "health: <stage> rate .. | driver <name> frames .. | writer <name>
+// writes .. failures .. failing 0|1 error '..'", for people and for the end-to-end tests to parse.
 void print_health(const sd::HealthReport& h) {
   std::cout << "health:";
   for (const auto& s : h.stages) {
@@ -33,6 +33,10 @@ void print_health(const sd::HealthReport& h) {
               << d.bus_off << " error_passive " << d.error_passive << " bus_restarts "
               << d.bus_restarts << " wakeup_p99 " << d.wakeup_p99_ms << " wakeup_max "
               << d.wakeup_max_ms << " |";
+  }
+  for (const auto& w : h.writers) {
+    std::cout << " writer " << w.name << " writes " << w.writes << " failures " << w.failures
+              << " failing " << (w.failing ? 1 : 0) << " error '" << w.last_error << "' |";
   }
   std::cout << std::endl;
 }

@@ -81,6 +81,9 @@ int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_confi
   if (!options.report_dir.empty()) {
     std::printf("report           : %s\n", report->write(pipeline).c_str());
   }
+  // A map that could not be saved (disk full) is a failure of its own: exit 3, after the
+  // summary; the checkpoint log still holds the map of its last checkpoint.
+  if (!pipeline.save_failures().empty()) return 3;
   // Stopped by a signal (systemctl stop, Ctrl-C), the run ended as asked: the map is saved, and
   // a service stopped before its filter initialised or its camera mapped has not failed.
   return g_stop.load() || pipeline.succeeded() ? 0 : 1;
@@ -90,6 +93,10 @@ int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_confi
 
 int main(int argc, char** argv) {
   CLI::App app{"semap-onboard: drivers, InEKF, S-BKI semantic map and DDS on one robot"};
+  app.footer(
+      "Exit status: 0 the run did its job or was stopped by a signal; 1 the filter never "
+      "initialised or nothing was mapped; 2 a configuration or start-up error; 3 the map "
+      "could not be saved at exit (the checkpoint log keeps it: --resume).");
   RunOptions options;
   std::string replay_dir, pace, save_path;
   std::optional<double> duration;
@@ -162,6 +169,11 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
+  // A file reaching the file-size limit (ulimit -f, LimitFSIZE=) would kill the robot with
+  // SIGXFSZ; ignored, the write fails with EFBIG instead and the writer handles it as a full
+  // disk: counted, reported in health, retried, while the robot drives on
+  // (docs/reliability.md).
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     return run(config, sim_config, options);
   } catch (const std::exception& e) {

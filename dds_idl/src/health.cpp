@@ -14,12 +14,18 @@ HealthMessage::HealthMessage(const HealthReport& r, const std::string& frame_id)
                         d.reconnects, d.bus_off, d.error_passive, d.bus_restarts, d.wakeup_p50_ms,
                         d.wakeup_p99_ms, d.wakeup_max_ms});
   }
+  for (const auto& w : r.writers) {
+    writers_.push_back({const_cast<char*>(w.name.c_str()), const_cast<char*>(w.path.c_str()),
+                        w.writes, w.failures, w.failing, const_cast<char*>(w.last_error.c_str())});
+  }
   msg_.header_.stamp_ = to_msg_time(r.stamp);
   msg_.header_.frame_id_ = const_cast<char*>(frame_id.c_str());
   msg_.stages_ = borrow_sequence<dds_sequence_semap_msgs_msg_dds__StageHealth_>(stages_.data(),
                                                                                 stages_.size());
   msg_.drivers_ = borrow_sequence<dds_sequence_semap_msgs_msg_dds__DriverCounters_>(
       drivers_.data(), drivers_.size());
+  msg_.writers_ = borrow_sequence<dds_sequence_semap_msgs_msg_dds__WriterHealth_>(writers_.data(),
+                                                                                  writers_.size());
 }
 
 HealthReport from_msg(const msg::Health& m) {
@@ -35,6 +41,11 @@ HealthReport from_msg(const msg::Health& m) {
     r.drivers.push_back({d.name_ ? d.name_ : "", d.frames_, d.bad_frames_, d.dropped_,
                          d.reconnects_, d.bus_off_, d.error_passive_, d.bus_restarts_,
                          d.wakeup_p50_ms_, d.wakeup_p99_ms_, d.wakeup_max_ms_});
+  }
+  for (std::uint32_t i = 0; i < m.writers_._length; ++i) {
+    const auto& w = m.writers_._buffer[i];
+    r.writers.push_back({w.name_ ? w.name_ : "", w.path_ ? w.path_ : "", w.writes_, w.failures_,
+                         w.failing_, w.last_error_ ? w.last_error_ : ""});
   }
   return r;
 }

@@ -49,39 +49,26 @@ std::uint32_t bytes_per_pixel(common::PixelFormat format) {
 // Fixed part of a frame record after the stamp: sequence, fourcc, width, height, stride, length.
 constexpr std::size_t kFrameFields = 6;
 
-}  // namespace
-
-StreamLogWriter::StreamLogWriter(const std::filesystem::path& path, StreamLogKind kind)
-    : path_(path), kind_(kind), file_(std::fopen(path.c_str(), "wb")) {
-  if (file_ == nullptr) {
-    throw std::runtime_error(path.string() + ": cannot create: " + std::strerror(errno));
-  }
-  std::array<std::uint8_t, 16> header{};
+std::vector<std::uint8_t> stream_log_header(StreamLogKind kind) {
+  std::vector<std::uint8_t> header(16);
   std::memcpy(header.data(), kMagic.data(), kMagic.size());
   store_u32(header.data() + 8, static_cast<std::uint32_t>(kind));
   store_u32(header.data() + 12, kVersion);
-  put(header.data(), header.size());
+  return header;
 }
 
-StreamLogWriter::~StreamLogWriter() {
-  if (file_ != nullptr) std::fclose(file_);
-}
+}  // namespace
 
-bool StreamLogWriter::put(const void* data, std::size_t len) {
-  if (!ok_) return false;
-  if (len > 0 && std::fwrite(data, 1, len, file_) != len) ok_ = false;
-  if (ok_) size_ += len;
-  return ok_;
-}
+StreamLogWriter::StreamLogWriter(const std::filesystem::path& path, StreamLogKind kind,
+                                 std::chrono::steady_clock::duration retry_after)
+    : kind_(kind), file_(path, stream_log_header(kind), retry_after) {}
 
 bool StreamLogWriter::write_bytes(common::Stamp stamp, std::span<const std::uint8_t> bytes) {
   if (kind_ != StreamLogKind::kBytes || bytes.size() > kStreamLogMaxChunk) return false;
   std::array<std::uint8_t, 12> head{};
   store_i64(head.data(), stamp.ns);
   store_u32(head.data() + 8, static_cast<std::uint32_t>(bytes.size()));
-  if (!put(head.data(), head.size()) || !put(bytes.data(), bytes.size())) return false;
-  ++records_;
-  return true;
+  return file_.append(head, bytes);
 }
 
 bool StreamLogWriter::write_frame(const common::ImageFrame& frame) {
@@ -93,14 +80,7 @@ bool StreamLogWriter::write_frame(const common::ImageFrame& frame) {
       frame.width,    frame.height,
       frame.stride,   static_cast<std::uint32_t>(frame.data.size())};
   for (std::size_t i = 0; i < fields.size(); ++i) store_u32(head.data() + 8 + 4 * i, fields[i]);
-  if (!put(head.data(), head.size()) || !put(frame.data.data(), frame.data.size())) return false;
-  ++records_;
-  return true;
-}
-
-bool StreamLogWriter::flush() {
-  if (ok_ && std::fflush(file_) != 0) ok_ = false;
-  return ok_;
+  return file_.append(head, frame.data);
 }
 
 StreamLogReader::StreamLogReader(std::istream& in, std::string name, StreamLogKind kind)

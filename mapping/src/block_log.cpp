@@ -192,11 +192,21 @@ BlockLog::BlockLog(std::filesystem::path path, const MapParams& params, bool dur
   fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd_ < 0) fail(path_, "open");
   struct stat st {};
-  if (::fstat(fd_, &st) != 0) fail(path_, "stat");
+  if (::fstat(fd_, &st) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    errno = error;
+    fail(path_, "stat");
+  }
   if (st.st_size == 0) {
-    const auto header = header_bytes(params_);
-    write_at_end(header);
-    if (durable_ && ::fsync(fd_) != 0) fail(path_, "fsync");
+    // A robot that boots with a full disk still maps: the header then goes in front of the
+    // first record that fits, and the checkpoints report the failures until then.
+    header_pending_ = true;
+    try {
+      write_at_end({});
+      if (durable_) ::fsync(fd_);
+    } catch (const BlockLogError&) {
+    }
     return;
   }
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(st.st_size));
@@ -220,15 +230,36 @@ BlockLog::~BlockLog() {
 }
 
 void BlockLog::write_at_end(std::span<const std::uint8_t> bytes) {
+  std::vector<std::uint8_t> with_header;
+  if (header_pending_) {
+    with_header = header_bytes(params_);
+    with_header.insert(with_header.end(), bytes.begin(), bytes.end());
+    bytes = with_header;
+  }
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n =
         ::pwrite(fd_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(end_ + done));
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) fail(path_, "write");
+    if (n <= 0) {
+      // Disk full (ENOSPC), file size limit (EFBIG with SIGXFSZ ignored), I/O error: the part
+      // that was written is cut off again, so the log ends with its last whole record and the
+      // next append or a resume finds no torn bytes.
+      const int error = n == 0 ? ENOSPC : errno;
+      cut_back_to(end_);
+      errno = error;
+      fail(path_, "write");
+    }
     done += static_cast<std::size_t>(n);
   }
   end_ += bytes.size();
+  header_pending_ = false;
+}
+
+void BlockLog::cut_back_to(std::uint64_t end) {
+  // Best effort: when even this fails the torn bytes stay beyond end_; the next record is
+  // written over them and opening the log cuts whatever follows its last commit.
+  if (::ftruncate(fd_, static_cast<off_t>(end)) == 0) end_ = end;
 }
 
 void BlockLog::append(const common::BlockIndex& index, std::uint64_t scan,
@@ -257,18 +288,34 @@ void BlockLog::append(const common::BlockIndex& index, std::uint64_t scan,
 void BlockLog::commit(std::uint64_t scans) {
   Writer payload;
   payload.put(scans);
-  const auto record = record_bytes(kCommitRecord, payload.bytes);
+  const auto commit = record_bytes(kCommitRecord, payload.bytes);
   std::lock_guard lock(mutex_);
-  write_at_end(record);
-  if (durable_ && ::fdatasync(fd_) != 0) fail(path_, "fsync");
+  // The frame goes in front of the commit that makes it part of the map, in one write.
+  std::vector<std::uint8_t> records;
+  if (frame_ && frame_unwritten_) records = frame_record(*frame_);
+  records.insert(records.end(), commit.begin(), commit.end());
+  const std::uint64_t before = end_;
+  const bool header_was_pending = header_pending_;
+  write_at_end(records);
+  if (durable_ && ::fdatasync(fd_) != 0) {
+    // Not known to be on disk (ENOSPC and EIO can come this late): not a checkpoint. The
+    // commit is taken back so that the log does not claim a map it may not hold.
+    const int error = errno;
+    cut_back_to(before);
+    header_pending_ = header_was_pending;
+    errno = error;
+    fail(path_, "fsync");
+  }
   committed_scans_ = scans;
+  frame_unwritten_ = false;
 }
 
 void BlockLog::set_frame(const MapFrame& frame) {
-  const auto record = frame_record(frame);
   std::lock_guard lock(mutex_);
-  write_at_end(record);
+  // Written with the next commit (a frame counts from its commit on anyway), so recording
+  // it never writes and cannot fail on a full disk.
   frame_ = frame;
+  frame_unwritten_ = true;
 }
 
 std::optional<MapFrame> BlockLog::frame() const {
@@ -329,52 +376,49 @@ bool BlockLog::compact(double factor) {
   for (const auto& [index, entry] : blocks_) live += entry.bytes;
   if (static_cast<double>(end_) <= factor * static_cast<double>(live)) return false;
   const std::filesystem::path temp = path_.string() + ".compacting";
-  const int out = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  // Read-write: after the rename this descriptor is the log's, so no reopen can fail.
+  const int out = ::open(temp.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (out < 0) fail(temp, "open");
-  const auto put = [&](std::span<const std::uint8_t> bytes) {
-    if (::write(out, bytes.data(), bytes.size()) != static_cast<ssize_t>(bytes.size())) {
-      ::close(out);
-      fail(temp, "write");
-    }
-  };
   std::unordered_map<common::BlockIndex, BlockLogEntry, common::BlockIndexHash> moved;
   std::uint64_t at = 0;
-  const auto header = header_bytes(params_);
-  put(header);
-  at += header.size();
-  if (frame_) {
-    const auto frame = frame_record(*frame_);
-    put(frame);
-    at += frame.size();
-  }
-  for (const auto& [index, entry] : blocks_) {
-    put(read_record(entry));
-    moved[index] = {at, entry.bytes, entry.scan};
-    at += entry.bytes;
-  }
-  Writer payload;
-  payload.put(committed_scans_);
-  const auto record = record_bytes(kCommitRecord, payload.bytes);
-  put(record);
-  at += record.size();
-  if (::fsync(out) != 0) {
+  try {
+    const auto put = [&](std::span<const std::uint8_t> bytes) {
+      errno = ENOSPC;  // what a short write without an error means
+      if (::write(out, bytes.data(), bytes.size()) != static_cast<ssize_t>(bytes.size())) {
+        fail(temp, "write");
+      }
+      at += bytes.size();
+    };
+    put(header_bytes(params_));
+    if (frame_) put(frame_record(*frame_));
+    for (const auto& [index, entry] : blocks_) {
+      moved[index] = {at, entry.bytes, entry.scan};
+      put(read_record(entry));
+    }
+    Writer payload;
+    payload.put(committed_scans_);
+    put(record_bytes(kCommitRecord, payload.bytes));
+    if (::fsync(out) != 0) fail(temp, "fsync");
+    if (::rename(temp.c_str(), path_.c_str()) != 0) fail(path_, "rename");
+  } catch (const BlockLogError&) {
+    // The log stays as it was, and the temporary goes: on a full disk it holds the space
+    // the log needs to go on.
     ::close(out);
-    fail(temp, "fsync");
+    ::unlink(temp.c_str());
+    throw;
   }
-  ::close(out);
-  if (::rename(temp.c_str(), path_.c_str()) != 0) fail(path_, "rename");
   const int dir = ::open(path_.parent_path().empty() ? "." : path_.parent_path().c_str(),
                          O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir >= 0) {
     ::fsync(dir);
     ::close(dir);
   }
-  const int fd = ::open(path_.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd < 0) fail(path_, "reopen");
   ::close(fd_);
-  fd_ = fd;
+  fd_ = out;
   blocks_ = std::move(moved);
   end_ = at;
+  frame_unwritten_ = false;  // the compacted log holds the frame and a commit
+  header_pending_ = false;
   return true;
 }
 

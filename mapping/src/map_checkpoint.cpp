@@ -20,6 +20,7 @@ MapCheckpoint::MapCheckpoint(SemanticMap& map, const CheckpointParams& params, b
                         ": holds a map already: resume it, or move the file away");
   }
   stats_.log_bytes = log_.bytes();
+  stats_.committed_scans = log_.committed_scans();
   writer_ = std::jthread([this](std::stop_token stop) { run(stop); });
 }
 
@@ -34,11 +35,12 @@ void MapCheckpoint::after_insert(const InsertResult& result) {
 }
 
 void MapCheckpoint::poll() {
-  if (dirty_.empty()) return;
   const auto now = std::chrono::steady_clock::now();
   if (std::chrono::duration<double>(now - last_).count() < params_.interval_s) return;
   std::lock_guard lock(mutex_);
   if (pending_) return;  // the writer is still busy: these changes go in the next one
+  take_retries();
+  if (dirty_.empty()) return;
   batch_ = copy_dirty();
   pending_ = true;
   last_ = now;
@@ -62,13 +64,41 @@ MapCheckpoint::Batch MapCheckpoint::copy_dirty() {
   return batch;
 }
 
+void MapCheckpoint::take_retries() {
+  dirty_.insert(retry_.begin(), retry_.end());
+  retry_.clear();
+}
+
+void MapCheckpoint::failed(const Batch& batch, const std::string& error) {
+  std::lock_guard lock(mutex_);
+  for (const BlockCopy& copy : batch.blocks) retry_.insert(copy.index);
+  ++stats_.write_failures;
+  stats_.failing = true;
+  stats_.last_error = error;
+  stats_.log_bytes = log_.bytes();
+}
+
 void MapCheckpoint::write(const Batch& batch) {
   const auto start = std::chrono::steady_clock::now();
-  for (const BlockCopy& copy : batch.blocks) {
-    log_.append(copy.index, batch.scans, copy.evidence, copy.observed);
+  try {
+    for (const BlockCopy& copy : batch.blocks) {
+      log_.append(copy.index, batch.scans, copy.evidence, copy.observed);
+    }
+    log_.commit(batch.scans);
+  } catch (const std::exception& e) {
+    // Whatever went wrong (BlockLogError, or no memory for a record), the thread lives on.
+    failed(batch, e.what());
+    return;
   }
-  log_.commit(batch.scans);
-  log_.compact();
+  std::string compact_error;
+  if (log_.bytes() > compact_after_bytes_) {
+    try {
+      log_.compact();
+    } catch (const std::exception& e) {
+      compact_error = e.what();
+      compact_after_bytes_ = log_.bytes() + log_.bytes() / 4;
+    }
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard lock(mutex_);
@@ -77,6 +107,14 @@ void MapCheckpoint::write(const Batch& batch) {
   stats_.last_write_s = seconds;
   stats_.max_write_s = std::max(stats_.max_write_s, seconds);
   stats_.log_bytes = log_.bytes();
+  stats_.committed_scans = batch.scans;
+  // A failed compaction costs disk space, not the checkpoint: it is counted but the log is
+  // up to date.
+  stats_.failing = false;
+  if (!compact_error.empty()) {
+    ++stats_.write_failures;
+    stats_.last_error = compact_error;
+  }
 }
 
 void MapCheckpoint::run(std::stop_token stop) {
@@ -97,6 +135,7 @@ void MapCheckpoint::flush() {
   {
     std::unique_lock lock(mutex_);
     done_.wait(lock, [this] { return !pending_; });
+    take_retries();
   }
   write(copy_dirty());
   last_ = std::chrono::steady_clock::now();
@@ -141,7 +180,17 @@ void MapPager::update(const Eigen::Vector3f& robot) {
   const auto scans = static_cast<std::uint64_t>(map_.scans());
   for (const common::BlockIndex& index : far) {
     const Block& block = *map_.find_block(index);
-    log_.append(index, scans, block.evidence(), block.observed_words());
+    try {
+      log_.append(index, scans, block.evidence(), block.observed_words());
+    } catch (const BlockLogError& e) {
+      // Only a block the log holds may leave memory. The rest wait for the next update: one
+      // failed record per insert while the disk is full, not one per far block.
+      ++stats_.write_failures;
+      stats_.failing = true;
+      stats_.last_error = e.what();
+      break;
+    }
+    stats_.failing = false;
     map_.evict(index);
     out_.insert(index);
     ++stats_.evicted;

@@ -4,7 +4,8 @@ namespace semap::onboard {
 
 dds_idl::HealthReport HealthMonitor::report(common::Stamp now,
                                             const std::vector<StageFigures>& stages,
-                                            std::vector<dds_idl::DriverCountersData> drivers) {
+                                            std::vector<dds_idl::DriverCountersData> drivers,
+                                            std::vector<dds_idl::WriterHealthData> writers) {
   dds_idl::HealthReport r;
   r.stamp = now;
   for (const StageFigures& s : stages) {
@@ -26,6 +27,7 @@ dds_idl::HealthReport HealthMonitor::report(common::Stamp now,
     r.stages.push_back(std::move(h));
   }
   r.drivers = std::move(drivers);
+  r.writers = std::move(writers);
   return r;
 }
 

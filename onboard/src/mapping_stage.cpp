@@ -1,5 +1,6 @@
 #include "semap/onboard/mapping_stage.hpp"
 
+#include <spdlog/fmt/fmt.h>
 #include <tbb/task_arena.h>
 
 #include <chrono>
@@ -71,9 +72,38 @@ MappingStage::MappingStage(const MappingConfig& config,
   if (paged) {
     pager_ = std::make_unique<mapping::MapPager>(map_, checkpoint_->log(), config.memory_radius_m);
   }
+  write_log_ = std::make_unique<WriteFailureLog>(
+      "mapping", "map checkpoint",
+      fmt::format("the log keeps its last complete checkpoint; retrying every {} s, mapping "
+                  "goes on",
+                  config.checkpoint_s));
   stage_.figures().checkpoint = checkpoint_->stats();
   stage_.figures().map = map_.stats();
   stage_.share();
+}
+
+dds_idl::WriterHealthData checkpoint_health(const MappingStageStats& stats,
+                                            const std::filesystem::path& path) {
+  const auto& c = stats.checkpoint;
+  const auto& p = stats.pager;
+  dds_idl::WriterHealthData h;
+  h.name = "map_checkpoint";
+  h.path = path.string();
+  h.writes = c.checkpoints;
+  // The checkpoint and the pager write the same log; a failing checkpoint says more.
+  h.failures = c.write_failures + p.write_failures;
+  h.failing = c.failing || p.failing;
+  h.last_error = c.failing || p.last_error.empty() ? c.last_error : p.last_error;
+  return h;
+}
+
+void MappingStage::note_writes() {
+  if (!checkpoint_) return;
+  auto& f = stage_.figures();
+  f.checkpoint = checkpoint_->stats();
+  if (pager_) f.pager = pager_->stats();
+  const auto health = checkpoint_health(f, {});
+  write_log_->update(health.failures, health.failing, health.last_error);
 }
 
 MappingStage::~MappingStage() { stop(); }
@@ -85,7 +115,7 @@ void MappingStage::start() {
 void MappingStage::stop() {
   if (stage_.stop() && checkpoint_) {
     checkpoint_->flush();
-    stage_.figures().checkpoint = checkpoint_->stats();
+    note_writes();
     stage_.share();
   }
 }
@@ -120,11 +150,17 @@ void MappingStage::run(std::stop_token stop) {
     sink_(resumed);
   }
   common::LabeledCloud cloud;
+  int idle = 0;
   // Asked to stop, it first maps what the ring still holds (perception has stopped).
   while (true) {
     if (!clouds_.try_pop(cloud)) {
       if (stop.stop_requested()) break;
       if (checkpoint_) checkpoint_->poll();
+      // A standing robot's checkpoint retries are reported too, twice a second.
+      if (checkpoint_ && ++idle % 100 == 0) {
+        note_writes();
+        stage_.share();
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       continue;
     }
@@ -153,8 +189,7 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   stage_.figures().insert_seconds_total += seconds;
   stage_.figures().insert_seconds_max = std::max(stage_.figures().insert_seconds_max, seconds);
   stage_.figures().map = map_.stats();
-  if (checkpoint_) stage_.figures().checkpoint = checkpoint_->stats();
-  if (pager_) stage_.figures().pager = pager_->stats();
+  note_writes();
   if (sink_) sink_(result.updated_blocks);
   stage_.share();
 }

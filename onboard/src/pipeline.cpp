@@ -162,7 +162,7 @@ void Pipeline::tick() {
     next_health_ = now + 1.0;
     dds_->publish_health(health_.report(
         now, stage_figures(rings(), *estimation_, perception_.get(), *mapping_, *dds_),
-        rig_->drivers().health()));
+        rig_->drivers().health(), writers()));
   }
   if (now >= next_progress_) {
     next_progress_ = now + 5.0;
@@ -189,7 +189,17 @@ void Pipeline::stop() {
 
 bool Pipeline::succeeded() const {
   const bool mapped = !(rig_->has_camera() || rig_->has_lidar()) || mapping_->stats().scans > 0;
-  return (rig_->gives_poses() || estimation_->stats().initialised) && mapped;
+  return (rig_->gives_poses() || estimation_->stats().initialised) && mapped &&
+         save_failures_.empty();
+}
+
+std::vector<dds_idl::WriterHealthData> Pipeline::writers() const {
+  std::vector<dds_idl::WriterHealthData> out;
+  if (!checkpoint_path_.empty() && config_.map.checkpoint_s > 0.0) {
+    out.push_back(checkpoint_health(mapping_->stats(), checkpoint_path_));
+  }
+  for (const PipelineObserver* o : observers_) o->writers(out);
+  return out;
 }
 
 bool Pipeline::has_taken(const HandedOver& handed) const {
@@ -205,7 +215,15 @@ bool Pipeline::has_taken(const HandedOver& handed) const {
 }
 
 void Pipeline::save_map(const std::filesystem::path& path) {
-  mapping::write_smap(path, map().layers());
+  try {
+    mapping::write_smap(path, map().layers());
+  } catch (const std::exception& e) {
+    // write_smap names the file and step; an older map there is left as it was.
+    const std::string what = e.what();
+    save_failures_.push_back(
+        what.find(path.string()) == std::string::npos ? path.string() + ": " + what : what);
+    throw;
+  }
   common::logger("onboard")->info("map saved to {}", path.string());
 }
 
@@ -230,6 +248,9 @@ std::vector<std::string> Pipeline::summary() const {
   if (!rig_->gives_poses()) estimation_summary(estimation_->stats(), lines);
   if (perception_) perception_summary(*perception_, lines);
   mapping_summary(mapping_->stats(), checkpoint_path_, config_.map.memory_radius_m, lines);
+  for (const std::string& failure : save_failures_) {
+    lines.push_back("map save failed  : " + failure);
+  }
   if (dds_) dds_summary(*dds_, lines);
   rig_->summary(lines);
   for (const PipelineObserver* o : observers_) o->summary(lines);

@@ -37,13 +37,24 @@ void mapping_summary(const MappingStageStats& map, const std::filesystem::path& 
                   map.scans ? 1e3 * map.insert_seconds_total / static_cast<double>(map.scans) : 0.0,
                   1e3 * map.insert_seconds_max, map.map.blocks, map.map.observed_cells,
                   map.map.bytes_per_cell()));
-  if (map.checkpoint.checkpoints > 0 || map.checkpoint.resumed_scans > 0) {
+  const auto& c = map.checkpoint;
+  const std::uint64_t failures = c.write_failures + map.pager.write_failures;
+  if (c.checkpoints > 0 || c.resumed_scans > 0 || failures > 0) {
     lines.push_back(fmt::format(
         "map checkpoint   : {}, {} checkpoints, {} blocks written, write max {:.1f} ms, "
-        "{:.1f} MB, resumed {} blocks of {} scans",
-        checkpoint_path.string(), map.checkpoint.checkpoints, map.checkpoint.blocks_written,
-        1e3 * map.checkpoint.max_write_s, static_cast<double>(map.checkpoint.log_bytes) / 1e6,
-        map.checkpoint.resumed_blocks, map.checkpoint.resumed_scans));
+        "{:.1f} MB, resumed {} blocks of {} scans, {} write failures",
+        checkpoint_path.string(), c.checkpoints, c.blocks_written, 1e3 * c.max_write_s,
+        static_cast<double>(c.log_bytes) / 1e6, c.resumed_blocks, c.resumed_scans, failures));
+  }
+  if (failures > 0) {
+    // Where the log stands for a --resume, and why it stopped there.
+    const auto health = checkpoint_health(map, checkpoint_path);
+    lines.push_back(fmt::format(
+        "checkpoint fails : {} checkpoints and {} evictions not written, {}; the log holds the "
+        "map of scan {}; last error: {}",
+        c.write_failures, map.pager.write_failures,
+        health.failing ? "still failing at exit" : "writing again at exit", c.committed_scans,
+        health.last_error));
   }
   if (memory_radius_m > 0.0) {
     lines.push_back(

@@ -39,7 +39,22 @@ void run_service(Pipeline& pipeline, const std::atomic<bool>& stop_requested,
     }
   });
   pipeline.stop();
-  for (const auto& path : save_paths) pipeline.save_map(path);
+  for (const auto& path : save_paths) {
+    // A full disk fails one save, not the others nor the exit: the summary still comes and
+    // the checkpoint log keeps the map up to its last checkpoint (save_failures() has it).
+    try {
+      pipeline.save_map(path);
+    } catch (const std::exception& e) {
+      // save_failures() names the map's own path besides the temporary that failed.
+      const auto& failures = pipeline.save_failures();
+      const auto checkpoint = pipeline.checkpoint_path();
+      common::logger("onboard")->error(
+          "map not saved: {}{}", failures.empty() ? e.what() : failures.back(),
+          checkpoint.empty()
+              ? ""
+              : "; " + checkpoint.string() + " keeps the map of the last checkpoint (--resume)");
+    }
+  }
 }
 
 }  // namespace semap::onboard

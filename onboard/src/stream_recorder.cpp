@@ -2,15 +2,23 @@
 
 #include <spdlog/fmt/fmt.h>
 
-#include <cerrno>
 #include <cstring>
 #include <stdexcept>
 
-#include "semap/common/logging.hpp"
 #include "semap/firmware_bridge/candump_log.h"
 #include "semap/firmware_bridge/candump_reader.hpp"
 
 namespace semap::onboard {
+
+StreamRecorder::Stream::Stream()
+    : failures("recorder", "recording",
+               "records are dropped and counted, writing is tried again every second; the "
+               "robot goes on") {}
+
+void StreamRecorder::Stream::note() {
+  const auto& f = file();
+  failures.update(f.failures(), f.failing(), f.error());
+}
 
 StreamRecorder::StreamRecorder(const std::filesystem::path& dir,
                                const std::filesystem::path& config_file, std::string can_interface)
@@ -22,27 +30,20 @@ StreamRecorder::StreamRecorder(const std::filesystem::path& dir,
   if (interface_.empty() || interface_.size() > SEMAP_CANDUMP_MAX_INTERFACE) interface_ = "sim";
   std::filesystem::copy_file(config_file, dir_ / RecordingFiles::kConfig,
                              std::filesystem::copy_options::overwrite_existing);
-  const auto imu = dir_ / RecordingFiles::kImu;
-  can_log_ = std::fopen(imu.c_str(), "w");
-  if (can_log_ == nullptr) {
-    throw std::runtime_error(imu.string() + ": cannot create: " + std::strerror(errno));
-  }
-  gnss_.log = std::make_unique<drivers::StreamLogWriter>(dir_ / RecordingFiles::kGnss,
-                                                         drivers::StreamLogKind::kBytes);
-  colour_.log = std::make_unique<drivers::StreamLogWriter>(dir_ / RecordingFiles::kColour,
-                                                           drivers::StreamLogKind::kFrames);
-  depth_.log = std::make_unique<drivers::StreamLogWriter>(dir_ / RecordingFiles::kDepth,
-                                                          drivers::StreamLogKind::kFrames);
+  can_ = std::make_unique<Stream>();
+  can_->lines = std::make_unique<drivers::AppendFile>(dir_ / RecordingFiles::kImu,
+                                                      std::vector<std::uint8_t>{});
+  const auto stream_log = [&](const char* name, drivers::StreamLogKind kind) {
+    auto stream = std::make_unique<Stream>();
+    stream->log = std::make_unique<drivers::StreamLogWriter>(dir_ / name, kind);
+    return stream;
+  };
+  gnss_ = stream_log(RecordingFiles::kGnss, drivers::StreamLogKind::kBytes);
+  colour_ = stream_log(RecordingFiles::kColour, drivers::StreamLogKind::kFrames);
+  depth_ = stream_log(RecordingFiles::kDepth, drivers::StreamLogKind::kFrames);
 }
 
-StreamRecorder::~StreamRecorder() {
-  flush();
-  if (can_log_ != nullptr) std::fclose(can_log_);
-}
-
-void StreamRecorder::failed(const std::string& what, std::uint64_t& failures) {
-  if (failures++ == 0) common::logger("recorder")->error("{}: write failed; recording stops", what);
-}
+StreamRecorder::~StreamRecorder() { flush(); }
 
 void StreamRecorder::can_frame(common::Stamp stamp, const SemapCanFrame& frame, bool error_frame) {
   SemapCandumpRecord record{};
@@ -52,50 +53,38 @@ void StreamRecorder::can_frame(common::Stamp stamp, const SemapCanFrame& frame, 
   record.kind = error_frame ? SEMAP_CANDUMP_ERROR : SEMAP_CANDUMP_DATA;
   record.frame = frame;
   const std::string line = firmware_bridge::format_candump_line(record);
-  std::lock_guard lock(can_mutex_);
-  if (!can_ok_ || line.empty() ||
-      std::fwrite(line.data(), 1, line.size(), can_log_) != line.size()) {
-    can_ok_ = false;
-    failed((dir_ / RecordingFiles::kImu).string(), can_failures_);
-    return;
-  }
-  ++can_frames_;
-  can_bytes_ += line.size();
+  if (line.empty()) return;
+  std::lock_guard lock(can_->mutex);
+  can_->lines->append({reinterpret_cast<const std::uint8_t*>(line.data()), line.size()});
+  can_->note();
 }
 
 void StreamRecorder::gnss_bytes(common::Stamp stamp, std::span<const std::uint8_t> bytes) {
-  std::lock_guard lock(gnss_.mutex);
-  if (gnss_.log->write_bytes(stamp, bytes)) {
-    gnss_.payload += bytes.size();
-  } else {
-    failed(gnss_.log->path().string(), gnss_.failures);
-  }
+  std::lock_guard lock(gnss_->mutex);
+  if (gnss_->log->write_bytes(stamp, bytes)) gnss_->payload += bytes.size();
+  gnss_->note();
 }
 
 void StreamRecorder::write_frame(Stream& stream, const common::ImageFrame& frame) {
   std::lock_guard lock(stream.mutex);
-  if (stream.log->write_frame(frame)) {
-    stream.payload += frame.data.size();
-  } else {
-    failed(stream.log->path().string(), stream.failures);
-  }
+  if (stream.log->write_frame(frame)) stream.payload += frame.data.size();
+  stream.note();
 }
 
-void StreamRecorder::colour_frame(const common::ImageFrame& frame) { write_frame(colour_, frame); }
+void StreamRecorder::colour_frame(const common::ImageFrame& frame) { write_frame(*colour_, frame); }
 
-void StreamRecorder::depth_frame(const common::ImageFrame& frame) { write_frame(depth_, frame); }
+void StreamRecorder::depth_frame(const common::ImageFrame& frame) { write_frame(*depth_, frame); }
 
 void StreamRecorder::flush() {
   {
-    std::lock_guard lock(can_mutex_);
-    if (can_log_ != nullptr && can_ok_ && std::fflush(can_log_) != 0) {
-      can_ok_ = false;
-      failed((dir_ / RecordingFiles::kImu).string(), can_failures_);
-    }
+    std::lock_guard lock(can_->mutex);
+    can_->lines->flush();
+    can_->note();
   }
-  for (Stream* s : {&gnss_, &colour_, &depth_}) {
+  for (Stream* s : {gnss_.get(), colour_.get(), depth_.get()}) {
     std::lock_guard lock(s->mutex);
-    if (!s->log->flush()) failed(s->log->path().string(), s->failures);
+    s->log->flush();
+    s->note();
   }
 }
 
@@ -116,30 +105,45 @@ void StreamRecorder::summary(std::vector<std::string>& lines) const {
   const auto r = counters();
   lines.push_back(fmt::format(
       "recording        : {}: {} CAN frames, {} GNSS reads ({} bytes), {} colour and {} "
-      "depth frames, {:.1f} MB, {} write failures",
+      "depth frames, {:.1f} MB, {} write failures{}",
       dir_.string(), r.can_frames, r.gnss_reads, r.gnss_bytes, r.colour_frames, r.depth_frames,
-      static_cast<double>(r.bytes) / 1e6, r.write_failures));
+      static_cast<double>(r.bytes) / 1e6, r.write_failures,
+      r.last_error.empty()
+          ? ""
+          : fmt::format(" ({}; last error: {})",
+                        r.failing ? "still failing at exit" : "writing again", r.last_error)));
+}
+
+void StreamRecorder::writers(std::vector<dds_idl::WriterHealthData>& out) const {
+  const auto r = counters();
+  dds_idl::WriterHealthData h;
+  h.name = "recorder";
+  h.path = dir_.string();
+  h.writes = r.can_frames + r.gnss_reads + r.colour_frames + r.depth_frames;
+  h.failures = r.write_failures;
+  h.failing = r.failing;
+  h.last_error = r.last_error;
+  out.push_back(std::move(h));
 }
 
 RecorderCounters StreamRecorder::counters() const {
   RecorderCounters c;
-  {
-    std::lock_guard lock(can_mutex_);
-    c.can_frames = can_frames_;
-    c.bytes += can_bytes_;
-    c.write_failures += can_failures_;
-  }
   const auto add = [&](const Stream& s, std::uint64_t& records) {
     std::lock_guard lock(s.mutex);
-    records = s.log->records();
-    c.bytes += s.log->size();
-    c.write_failures += s.failures;
+    const auto& f = s.file();
+    records = f.records();
+    c.bytes += f.bytes();
+    c.write_failures += f.lost();
+    // A failing stream's error says more than one that has recovered.
+    if (!f.error().empty() && (f.failing() || !c.failing)) c.last_error = f.error();
+    c.failing = c.failing || f.failing();
   };
-  add(gnss_, c.gnss_reads);
-  add(colour_, c.colour_frames);
-  add(depth_, c.depth_frames);
-  std::lock_guard lock(gnss_.mutex);
-  c.gnss_bytes = gnss_.payload;
+  add(*can_, c.can_frames);
+  add(*gnss_, c.gnss_reads);
+  add(*colour_, c.colour_frames);
+  add(*depth_, c.depth_frames);
+  std::lock_guard lock(gnss_->mutex);
+  c.gnss_bytes = gnss_->payload;
   return c;
 }
 

@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "checkpoint_test_support.hpp"
 #include "toy_dataset.hpp"
 
 namespace semap::mapping {
@@ -18,48 +19,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch_dir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("semap_checkpoint_" + std::to_string(::getpid()) + "_" + name);
-  fs::create_directories(dir);
-  return dir;
-}
-
-// The directory a death test shares with its child (the same binary, re-executed, which
-// inherits the environment), removed with the variable at the end of the test.
-class SharedDir {
- public:
-  explicit SharedDir(const std::string& name) {
-    const char* inherited = std::getenv(kVariable);
-    dir_ = inherited != nullptr ? fs::path(inherited) : scratch_dir(name);
-    ::setenv(kVariable, dir_.c_str(), 1);
-  }
-  ~SharedDir() {
-    ::unsetenv(kVariable);
-    fs::remove_all(dir_);
-  }
-  const fs::path& path() const { return dir_; }
-
- private:
-  static constexpr const char* kVariable = "SEMAP_CHECKPOINT_TEST_DIR";
-  fs::path dir_;
-};
-
-// Bit-for-bit equality of the blocks in memory.
-void expect_same_map(const SemanticMap& a, const SemanticMap& b) {
-  EXPECT_EQ(a.stats().blocks, b.stats().blocks);
-  std::size_t differing = 0;
-  a.for_each_block([&](const common::BlockIndex& index, const Block& block) {
-    const Block* other = b.find_block(index);
-    if (other == nullptr ||
-        !std::equal(block.evidence().begin(), block.evidence().end(), other->evidence().begin()) ||
-        !std::equal(block.observed_words().begin(), block.observed_words().end(),
-                    other->observed_words().begin())) {
-      ++differing;
-    }
-  });
-  EXPECT_EQ(differing, 0u);
-}
+using testing::expect_same_map;
+using testing::scratch_dir;
+using testing::SharedDir;
 
 // The robot: inserts the toy scans, checkpointing after every insert, and is killed with
 // SIGKILL after `scans` of them (optionally after idling for 0.5 s, polling as the mapping

@@ -2,6 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
+#include "semap/onboard/mapping_stage.hpp"
+#include "semap/onboard/write_failure_log.hpp"
+
 namespace semap::onboard {
 namespace {
 
@@ -46,6 +52,60 @@ TEST(HealthMonitor, DriverCountersSumIntegrityAndLosses) {
   EXPECT_FLOAT_EQ(d.wakeup_p50_ms, 0.1f);
   EXPECT_FLOAT_EQ(d.wakeup_p99_ms, 0.4f);
   EXPECT_FLOAT_EQ(d.wakeup_max_ms, 2.5f);
+}
+
+// A full disk reaches the health report: the checkpoint's and the pager's failures on the one
+// log, the error of whichever is failing, through the DDS message and back.
+TEST(HealthMonitor, CheckpointWriteFailuresReachTheReportAndTheMessage) {
+  MappingStageStats stats;
+  stats.checkpoint.checkpoints = 12;
+  stats.checkpoint.write_failures = 5;
+  stats.checkpoint.failing = true;
+  stats.checkpoint.last_error = "/data/map.smap.log: write: No space left on device";
+  stats.pager.write_failures = 2;
+  stats.pager.last_error = "/data/map.smap.log: write: File too large";
+  const auto w = checkpoint_health(stats, "/data/map.smap.log");
+  EXPECT_EQ(w.name, "map_checkpoint");
+  EXPECT_EQ(w.writes, 12u);
+  EXPECT_EQ(w.failures, 7u);
+  EXPECT_TRUE(w.failing);
+  EXPECT_EQ(w.last_error, stats.checkpoint.last_error);
+
+  HealthMonitor m;
+  const auto report = m.report(common::Stamp::from_seconds(5.0), {}, {}, {w});
+  const dds_idl::HealthMessage message(report, "base_link");
+  const auto back = dds_idl::from_msg(message.get());
+  ASSERT_EQ(back.writers.size(), 1u);
+  EXPECT_EQ(back.writers[0].path, "/data/map.smap.log");
+  EXPECT_EQ(back.writers[0].failures, 7u);
+  EXPECT_TRUE(back.writers[0].failing);
+  EXPECT_EQ(back.writers[0].last_error, stats.checkpoint.last_error);
+
+  // Once the checkpoint writes again, only the pager's failing would be reported.
+  stats.checkpoint.failing = false;
+  stats.pager.failing = true;
+  EXPECT_EQ(checkpoint_health(stats, "x").last_error, stats.pager.last_error);
+}
+
+// A disk that stays full must not flood the log: the first failure, one reminder per interval
+// however many failures came in it, and the recovery.
+TEST(WriteFailureLog, FirstFailureThenOneReminderPerIntervalThenTheRecovery) {
+  WriteFailureLog log("test", "map checkpoint", "retrying", std::chrono::milliseconds(200));
+  log.update(0, false, "");
+  EXPECT_EQ(log.lines(), 0u);
+  log.update(1, true, "map.log: write: No space left on device");
+  EXPECT_EQ(log.lines(), 1u);
+  for (std::uint64_t f = 2; f <= 50; ++f) log.update(f, true, "map.log: write: ...");
+  EXPECT_EQ(log.lines(), 1u);  // within the interval: counted, not logged
+  std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  log.update(51, true, "map.log: write: ...");
+  EXPECT_EQ(log.lines(), 2u);  // one reminder with the 50 since
+  log.update(51, false, "");
+  EXPECT_EQ(log.lines(), 3u);  // writing again
+  log.update(51, false, "");
+  EXPECT_EQ(log.lines(), 3u);
+  log.update(52, true, "again");  // a new episode starts with its own first line
+  EXPECT_EQ(log.lines(), 4u);
 }
 
 }  // namespace

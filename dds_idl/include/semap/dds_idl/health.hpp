@@ -36,10 +36,23 @@ struct DriverCountersData {
   float wakeup_max_ms = 0.0f;
 };
 
+// A file the robot keeps writing (the map checkpoint, a recording): `writes` done, `failures`
+// (disk full, file size limit, I/O error), whether the last attempt failed and its error (the
+// file, the step and the errno text).
+struct WriterHealthData {
+  std::string name;
+  std::string path;
+  std::uint64_t writes = 0;
+  std::uint64_t failures = 0;
+  bool failing = false;
+  std::string last_error;
+};
+
 struct HealthReport {
   common::Stamp stamp;
   std::vector<StageHealthData> stages;
   std::vector<DriverCountersData> drivers;
+  std::vector<WriterHealthData> writers;
 };
 
 // A Health message borrowing the report's strings: valid while the report lives unchanged.
@@ -53,6 +66,7 @@ class HealthMessage {
  private:
   std::vector<msg::StageHealth> stages_;
   std::vector<msg::DriverCounters> drivers_;
+  std::vector<msg::WriterHealth> writers_;
   msg::Health msg_{};
 };
 

@@ -34,6 +34,7 @@ using SemanticMapBlock = semap_msgs_msg_dds__SemanticMapBlock_;
 using MapInfo = semap_msgs_msg_dds__MapInfo_;
 using StageHealth = semap_msgs_msg_dds__StageHealth_;
 using DriverCounters = semap_msgs_msg_dds__DriverCounters_;
+using WriterHealth = semap_msgs_msg_dds__WriterHealth_;
 using Health = semap_msgs_msg_dds__Health_;
 }  // namespace msg
 

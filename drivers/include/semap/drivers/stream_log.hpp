@@ -1,7 +1,7 @@
 #pragma once
 
+#include <chrono>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
 #include <istream>
 #include <optional>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "semap/common/messages.hpp"
+#include "semap/drivers/append_file.hpp"
 
 namespace semap::drivers {
 
@@ -31,35 +32,29 @@ struct ByteChunk {
   std::vector<std::uint8_t> bytes;
 };
 
-// Appends records to a new log (an existing file is replaced). Writes go through stdio's
-// buffer; a failed write is remembered, and later writes are refused.
+// Appends records to a new log (an existing file is replaced), through an AppendFile: a write
+// that fails (disk full) is cut off so the log stays readable to its last whole record, its
+// records are counted as lost, and writing is tried again a second later.
 class StreamLogWriter {
  public:
   // Throws std::runtime_error naming the path when the file cannot be created.
-  StreamLogWriter(const std::filesystem::path& path, StreamLogKind kind);
-  ~StreamLogWriter();
-  StreamLogWriter(const StreamLogWriter&) = delete;
-  StreamLogWriter& operator=(const StreamLogWriter&) = delete;
+  StreamLogWriter(const std::filesystem::path& path, StreamLogKind kind,
+                  std::chrono::steady_clock::duration retry_after = std::chrono::seconds(1));
 
-  // False once a write failed (disk full, I/O error).
+  // False when the record is lost (disk full, I/O error) or malformed (wrong kind, too long).
   bool write_bytes(common::Stamp stamp, std::span<const std::uint8_t> bytes);
   bool write_frame(const common::ImageFrame& frame);
-  bool flush();
+  bool flush() { return file_.flush(); }
 
-  bool ok() const { return ok_; }
-  std::uint64_t records() const { return records_; }
-  std::uint64_t size() const { return size_; }  // bytes written, header included
-  const std::filesystem::path& path() const { return path_; }
+  bool ok() const { return !file_.failing(); }
+  std::uint64_t records() const { return file_.records(); }  // taken and not lost
+  std::uint64_t size() const { return file_.bytes(); }       // the same in bytes, with the header
+  const AppendFile& file() const { return file_; }           // losses and the last error
+  const std::filesystem::path& path() const { return file_.path(); }
 
  private:
-  bool put(const void* data, std::size_t len);
-
-  std::filesystem::path path_;
   StreamLogKind kind_;
-  std::FILE* file_ = nullptr;
-  bool ok_ = true;
-  std::uint64_t records_ = 0;
-  std::uint64_t size_ = 0;
+  AppendFile file_;
 };
 
 // Reads a log record by record. A damaged record (a length beyond the limits, an unknown pixel

@@ -66,12 +66,19 @@ BlockLogScan scan_block_log(std::span<const std::uint8_t> bytes, const MapParams
 // are the map after `scans` scans. A crash can only leave a torn tail after the last commit;
 // opening the log cuts it off, so the log resumes from the last complete checkpoint.
 //
+// A write that fails (disk full, file size limit, I/O error) throws BlockLogError naming the
+// file, the step and the errno text, and first cuts off what it wrote: the log keeps ending
+// with a whole record, the last commit stays the last checkpoint, and the log can be appended
+// to again once there is room.
+//
 // Thread-safe: the checkpoint thread appends and commits while the mapping thread's pager
 // appends and loads blocks.
 class BlockLog {
  public:
   // Opens `path`, creating it when missing. Throws BlockLogError as scan_block_log does, or
-  // naming the failing I/O step. `durable`: commits fsync the file (power-loss safe).
+  // naming the failing I/O step. `durable`: commits fsync the file (power-loss safe). A new
+  // log whose header does not fit (a full disk) opens all the same: the header is written
+  // with the first record that fits.
   BlockLog(std::filesystem::path path, const MapParams& params, bool durable = true);
   ~BlockLog();
   BlockLog(const BlockLog&) = delete;
@@ -81,9 +88,10 @@ class BlockLog {
   // newer copy of it (a pager wrote the block out after the checkpoint copied it).
   void append(const common::BlockIndex& index, std::uint64_t scan, std::span<const float> evidence,
               std::span<const std::uint64_t> observed);
-  // Appends a commit for the map after `scans` scans (fsyncs when durable).
+  // Appends a commit for the map after `scans` scans (fsyncs when durable). When the write or
+  // the fsync fails the commit is taken back: committed_scans() stays the last one.
   void commit(std::uint64_t scans);
-  // Records the map's frame (committed with the next commit).
+  // Records the map's frame; it is written with the next commit (so this never fails).
   void set_frame(const MapFrame& frame);
   std::optional<MapFrame> frame() const;
   // Restores the latest copy of a block into `map` (SemanticMap::restore_block); false when the
@@ -108,7 +116,10 @@ class BlockLog {
   const std::string& damage() const { return damage_; }
 
  private:
+  // Writes all of `bytes` at the end (with the header first when it is pending) or throws,
+  // having cut the file back to where it ended.
   void write_at_end(std::span<const std::uint8_t> bytes);
+  void cut_back_to(std::uint64_t end);
   std::vector<std::uint8_t> read_record(const BlockLogEntry& entry) const;
 
   std::filesystem::path path_;
@@ -120,6 +131,8 @@ class BlockLog {
   std::uint64_t end_ = 0;
   std::uint64_t committed_scans_ = 0;
   std::optional<MapFrame> frame_;
+  bool frame_unwritten_ = false;  // set_frame() since the last commit
+  bool header_pending_ = false;   // a new log whose header did not fit yet
   std::string damage_;
 };
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <unordered_set>
 #include <vector>
@@ -30,6 +31,12 @@ struct CheckpointParams {
 //
 // While the writer is busy, changes accumulate and go in its next checkpoint, so a slow disk
 // makes checkpoints rarer rather than queueing copies of the map.
+//
+// A checkpoint that cannot be written (disk full, file size limit, I/O error) is counted, with
+// its error, and never thrown: the log keeps its last complete checkpoint (BlockLog cuts off
+// the failed write), the blocks of the failed checkpoint go back among the changed ones, and
+// the next interval tries again with everything changed since the last commit, so writing
+// resumes by itself once there is room. Mapping goes on meanwhile.
 class MapCheckpoint {
  public:
   struct Stats {
@@ -38,8 +45,12 @@ class MapCheckpoint {
     double last_write_s = 0;           // writer time of the last checkpoint
     double max_write_s = 0;
     std::uint64_t log_bytes = 0;
-    std::uint64_t resumed_blocks = 0;  // loaded at start
-    std::uint64_t resumed_scans = 0;   // scans the resumed map had seen
+    std::uint64_t resumed_blocks = 0;   // loaded at start
+    std::uint64_t resumed_scans = 0;    // scans the resumed map had seen
+    std::uint64_t committed_scans = 0;  // the scans of the last commit in the log
+    std::uint64_t write_failures = 0;   // checkpoints (or compactions) not written
+    bool failing = false;               // the last checkpoint failed: the log is behind
+    std::string last_error;             // of the last failure: file, step, errno text
   };
 
   // Opens the log (BlockLogError when it belongs to other map parameters, or, without resume,
@@ -79,7 +90,11 @@ class MapCheckpoint {
   };
 
   Batch copy_dirty();
+  // Never throws: a failure is counted and its blocks are left in retry_.
   void write(const Batch& batch);
+  void failed(const Batch& batch, const std::string& error);
+  // Under mutex_: the blocks of a failed checkpoint join the changed ones (mapping thread).
+  void take_retries();
   void run(std::stop_token stop);
 
   SemanticMap& map_;
@@ -93,6 +108,11 @@ class MapCheckpoint {
   std::condition_variable done_;
   bool pending_ = false;  // batch_ waits for or is being written by the writer
   Batch batch_;
+  // Blocks of a failed checkpoint, to be copied again for the next one.
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> retry_;
+  // No compaction until the log is past this size again: a compaction that failed for want
+  // of room would fail the same way on every checkpoint until the disk has room again.
+  std::uint64_t compact_after_bytes_ = 0;
   Stats stats_;
   std::jthread writer_;
 };
@@ -108,6 +128,11 @@ class MapPager {
     std::uint64_t evicted = 0;
     std::uint64_t restored = 0;
     std::uint64_t late_restores = 0;  // blocks an insert reached before update() restored them
+    // Evictions whose block could not be written to the log (disk full): the block stays in
+    // memory, so memory grows past the radius rather than the map losing evidence.
+    std::uint64_t write_failures = 0;
+    bool failing = false;  // the last eviction attempt failed
+    std::string last_error;
   };
 
   // `log`'s blocks not in `map` count as paged out (a resumed map). Throws

@@ -26,8 +26,10 @@ struct StageFigures {
 // growth of its item count since the previous report, per second (0 on the first one).
 class HealthMonitor {
  public:
+  // `writers`: the files the robot keeps writing, passed through as they are.
   dds_idl::HealthReport report(common::Stamp now, const std::vector<StageFigures>& stages,
-                               std::vector<dds_idl::DriverCountersData> drivers);
+                               std::vector<dds_idl::DriverCountersData> drivers,
+                               std::vector<dds_idl::WriterHealthData> writers = {});
 
  private:
   struct Previous {

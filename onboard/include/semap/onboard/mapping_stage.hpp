@@ -13,6 +13,7 @@
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/dds_idl/block_snapshot.hpp"
+#include "semap/dds_idl/health.hpp"
 #include "semap/dds_idl/map_description.hpp"
 #include "semap/dds_idl/map_publisher.hpp"
 #include "semap/mapping/map_checkpoint.hpp"
@@ -20,6 +21,7 @@
 #include "semap/onboard/costmap_output.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/stage_thread.hpp"
+#include "semap/onboard/write_failure_log.hpp"
 
 namespace semap::onboard {
 
@@ -34,11 +36,17 @@ struct MappingStageStats {
   mapping::MapPager::Stats pager;            // zeros without a memory radius
 };
 
+// The checkpoint log's writes as the health report gives them: checkpoints written, failed
+// checkpoints and evictions (disk full), whether the last attempt failed and its error.
+dds_idl::WriterHealthData checkpoint_health(const MappingStageStats& stats,
+                                            const std::filesystem::path& path);
+
 // Owns the SemanticMap on its own thread: inserts every posed cloud and tells the block sink
 // (the DDS map publisher) which blocks the insert wrote. The publisher reads them, on its own
 // thread and at its own rate, through blocks(): a read-only view of the map that shares a
 // lock with the inserts, so the map is held once. With a checkpoint path the stage keeps the
-// map recoverable (MapCheckpoint) and, with a memory radius, bounded (MapPager).
+// map recoverable (MapCheckpoint) and, with a memory radius, bounded (MapPager). A checkpoint
+// that cannot be written (disk full) never stops mapping: it is counted, logged and retried.
 class MappingStage : private dds_idl::BlockSource, private CostmapSource {
  public:
   // Called on the mapping thread; must not block.
@@ -79,6 +87,9 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
  private:
   void run(std::stop_token stop);
   void insert(const common::LabeledCloud& cloud);
+  // Mapping thread: the checkpoint's and pager's figures into the stage's, their failures
+  // into the log (rate-limited).
+  void note_writes();
   // BlockSource, for the publisher's thread.
   void for_each_block(const std::function<void(const common::BlockIndex&)>& f) const override;
   bool read(const common::BlockIndex& index, dds_idl::BlockSnapshot& out) const override;
@@ -103,7 +114,8 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
   common::LatencyWindow latency_;
   common::LatencyWindow insert_time_;
-  StageThread<MappingStageStats> stage_;  // last: joined before the members it uses
+  std::unique_ptr<WriteFailureLog> write_log_;  // with a checkpoint
+  StageThread<MappingStageStats> stage_;        // last: joined before the members it uses
 };
 
 // The map's shape and its palette's class names and colours (0xRRGGBB), for MapInfo.

@@ -43,6 +43,8 @@ class PipelineObserver {
   virtual void on_stopped() {}
   // Its lines for the exit summary (after stop()).
   virtual void summary(std::vector<std::string>&) const {}
+  // The files it writes, for the health report (the thread calling tick(), once a second).
+  virtual void writers(std::vector<dds_idl::WriterHealthData>&) const {}
 };
 
 // The robot's pipeline, built from an OnboardConfig: the rings, the sensor rig that fills them,
@@ -92,15 +94,20 @@ class Pipeline {
   // Every ring's drops, by name.
   std::vector<std::pair<std::string, std::uint64_t>> ring_drops() const;
   // After stop(): the whole map (read back from the checkpoint when it was paged), and that map
-  // written as a .smap file.
+  // written as a .smap file. A save that fails (disk full) throws naming the file and leaves
+  // an older file there as it was; the failure is kept for the summary and succeeded().
   const mapping::SemanticMap& map() { return mapping_->map(); }
   void save_map(const std::filesystem::path& path);
+  // Saves that failed: "<path>: <error>".
+  const std::vector<std::string>& save_failures() const { return save_failures_; }
+  // The files being written (checkpoint, observers' files), as the health report gives them.
+  std::vector<dds_idl::WriterHealthData> writers() const;
   // After stop(): the exit summary, one line per part (tests read them).
   std::vector<std::string> summary() const;
   // After stop(): the process's CPU time over the run's wall time, in cores.
   double cpu_cores() const { return cpu_cores_; }
-  // After stop(): whether the run did its job: the filter initialised and, when the rig has a
-  // camera, something was mapped.
+  // After stop(): whether the run did its job: the filter initialised, when the rig has a
+  // camera something was mapped, and every map save worked.
   bool succeeded() const;
   const OnboardConfig& config() const { return config_; }
 
@@ -137,6 +144,7 @@ class Pipeline {
   common::Stamp next_progress_;
   bool frame_recorded_ = false;
   bool running_ = false;
+  std::vector<std::string> save_failures_;
 };
 
 }  // namespace semap::onboard

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -10,9 +9,11 @@
 #include <vector>
 
 #include "semap/common/messages.hpp"
+#include "semap/drivers/append_file.hpp"
 #include "semap/drivers/stream_log.hpp"
 #include "semap/firmware_bridge/can_frame.h"
 #include "semap/onboard/pipeline.hpp"
+#include "semap/onboard/write_failure_log.hpp"
 
 namespace semap::onboard {
 
@@ -33,13 +34,17 @@ struct RecorderCounters {
   std::uint64_t depth_frames = 0;
   std::uint64_t bytes = 0;           // written to disk, all files
   std::uint64_t write_failures = 0;  // records lost to a failed write (disk full, I/O error)
+  bool failing = false;              // a stream's last write failed
+  std::string last_error;            // a failing stream's error, else the last one
 };
 
 // Writes the raw sensor streams as they arrive: the IMU's CAN traffic as a `candump -L` log
 // (stamps are CLOCK_MONOTONIC, as the pipeline's; canplayer replays by their differences), the
 // GNSS port's bytes with their read stamps, colour and depth frames with their driver stamps,
-// and a copy of the configuration. Each stream is written by the thread that produces it; a
-// failed write is counted and logged once, and never stops the robot.
+// and a copy of the configuration. Each stream is written by the thread that produces it
+// (drivers::AppendFile). A write that fails (disk full) never stops the robot: the file keeps
+// its whole records, the lost ones are counted, logged (rate-limited) and reported in health,
+// and the stream records again once the disk has room.
 class StreamRecorder final : public PipelineObserver {
  public:
   // Creates `dir` (and fails, naming it, if it holds a recording already). `can_interface`
@@ -55,6 +60,7 @@ class StreamRecorder final : public PipelineObserver {
   void on_frame(const common::ImageFrame& frame, bool depth) override;
   void on_stopped() override { flush(); }
   void summary(std::vector<std::string>& lines) const override;
+  void writers(std::vector<dds_idl::WriterHealthData>& out) const override;
 
   void can_frame(common::Stamp stamp, const SemapCanFrame& frame, bool error_frame);
   void gnss_bytes(common::Stamp stamp, std::span<const std::uint8_t> bytes);
@@ -67,27 +73,27 @@ class StreamRecorder final : public PipelineObserver {
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
-  // One log file and the lock of the thread that writes it.
+  // One file, the lock of the thread that writes it, and the log line of its failures.
   struct Stream {
+    Stream();
+    const drivers::AppendFile& file() const { return log ? log->file() : *lines; }
+    // After a write, under the lock: its failures into the log.
+    void note();
+
     mutable std::mutex mutex;
-    std::unique_ptr<drivers::StreamLogWriter> log;
-    std::uint64_t payload = 0;  // bytes of the records' contents
-    std::uint64_t failures = 0;
+    std::unique_ptr<drivers::StreamLogWriter> log;  // GNSS, colour, depth
+    std::unique_ptr<drivers::AppendFile> lines;     // the CAN log
+    std::uint64_t payload = 0;                      // bytes of the records' contents (logs)
+    WriteFailureLog failures;
   };
   void write_frame(Stream& stream, const common::ImageFrame& frame);
-  void failed(const std::string& what, std::uint64_t& failures);
 
   std::filesystem::path dir_;
   std::string interface_;
-  mutable std::mutex can_mutex_;
-  std::FILE* can_log_ = nullptr;
-  std::uint64_t can_frames_ = 0;
-  std::uint64_t can_bytes_ = 0;
-  std::uint64_t can_failures_ = 0;
-  bool can_ok_ = true;
-  Stream gnss_;
-  Stream colour_;
-  Stream depth_;
+  std::unique_ptr<Stream> can_;
+  std::unique_ptr<Stream> gnss_;
+  std::unique_ptr<Stream> colour_;
+  std::unique_ptr<Stream> depth_;
 };
 
 }  // namespace semap::onboard
