@@ -1,6 +1,8 @@
 #include "semap/estimation/estimator.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numbers>
 
@@ -277,13 +279,31 @@ void Estimator::note_rejection(const Vector3d& residual) {
     return;
   }
   // The receiver's solution moved as a whole: shift the frame so the map stays continuous.
-  anchor_offset_ += mean;
   ++counters_.reanchors;
+  const Vector3d shifted = anchor_offset_ + mean;
+  // Back to a frame used before (multipath that ended, a correction source that returned):
+  // that frame exactly, rather than the mean of a few noisy residuals, which would leave the
+  // trajectory off by that error for good.
+  const auto back = std::find_if(
+      earlier_offsets_.rbegin(), earlier_offsets_.rend(),
+      [&](const Vector3d& o) { return (o - shifted).norm() <= config_.reanchor.max_spread_m; });
+  const bool returned = back != earlier_offsets_.rend();
+  if (returned) {
+    anchor_offset_ = *back;
+    earlier_offsets_.erase(std::prev(back.base()), earlier_offsets_.end());
+    ++counters_.reanchors_back;
+  } else {
+    constexpr std::size_t kFramesKept = 8;
+    if (earlier_offsets_.size() == kFramesKept) earlier_offsets_.erase(earlier_offsets_.begin());
+    earlier_offsets_.push_back(anchor_offset_);
+    anchor_offset_ = shifted;
+  }
   common::logger("estimation")
       ->warn(
-          "GNSS jump of {:.2f} m persisted for {} fixes: re-anchored (offset now {:.2f}, "
+          "GNSS jump of {:.2f} m persisted for {} fixes: re-anchored{} (offset now {:.2f}, "
           "{:.2f}, {:.2f})",
-          mean.norm(), config_.reanchor.after_rejections, anchor_offset_.x(), anchor_offset_.y(),
+          mean.norm(), config_.reanchor.after_rejections,
+          returned ? " back to the frame it left" : "", anchor_offset_.x(), anchor_offset_.y(),
           anchor_offset_.z());
 }
 

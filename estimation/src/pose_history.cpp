@@ -1,8 +1,17 @@
 #include "semap/estimation/pose_history.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace semap::estimation {
+
+double position_sigma_m(const Eigen::Matrix3d& covariance) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(covariance, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
+}
 
 PoseHistory::PoseHistory(std::size_t capacity) : ring_(capacity) {
   if (capacity < 2) throw std::invalid_argument("PoseHistory capacity must be >= 2");
@@ -47,6 +56,7 @@ std::optional<StampedPose> PoseHistory::at(common::Stamp stamp) const {
   out.orientation = a.orientation.slerp(f, b.orientation);
   out.position = a.position + f * (b.position - a.position);
   out.velocity = a.velocity + f * (b.velocity - a.velocity);
+  out.position_sigma_m = std::max(a.position_sigma_m, b.position_sigma_m);
   return out;
 }
 

@@ -67,8 +67,9 @@ bool EstimationStage::drain_sensors() {
     // how the thread happened to batch them (a replay maps what its recording mapped).
     check_heading();
     if (!stage_.figures().heading_settled && !trajectory_) continue;
-    const auto pose = estimator_.pose_at(estimator_.filter_time());
+    auto pose = estimator_.pose_at(estimator_.filter_time());
     if (!pose) continue;
+    pose->position_sigma_m = position_sigma();
     if (trajectory_) trajectory_->write(*pose);
     if (stage_.figures().heading_settled) new_poses_.push_back(*pose);
   }
@@ -101,6 +102,24 @@ void EstimationStage::check_heading() {
              yaw_sigma_deg);
 }
 
+// Reading the InEKF's covariance forms it from the window of deferred IMU steps (exactly, and
+// cached until the next step), so it is read at 20 Hz of filter time, and at once after a
+// correction or an inflation has changed it; the poses between carry the last reading.
+double EstimationStage::position_sigma() {
+  constexpr double kReadPeriodS = 0.05;
+  const auto& counters = estimator_.counters();
+  const std::uint64_t corrections =
+      counters.gnss_applied + counters.velocity_applied + counters.position_inflations;
+  const common::Stamp now = estimator_.filter_time();
+  if (now >= next_sigma_read_ || corrections != sigma_read_at_corrections_) {
+    position_sigma_m_ =
+        estimation::position_sigma_m(estimator_.filter().position_covariance_world());
+    next_sigma_read_ = now + kReadPeriodS;
+    sigma_read_at_corrections_ = corrections;
+  }
+  return position_sigma_m_;
+}
+
 void EstimationStage::publish_pose() {
   if (!pose_sink_ || !estimator_.initialised()) return;
   // The covariance is read only for a pose that is published (odometry rate).
@@ -131,6 +150,7 @@ void EstimationStage::share_stats() {
     p.orientation = Eigen::Quaterniond(state.rotation);
     p.position = state.position;
     p.velocity = state.velocity;
+    p.position_sigma_m = position_sigma_m_;
     stage_.figures().latest = p;
   }
   stage_.figures().anchor = estimator_.anchor();

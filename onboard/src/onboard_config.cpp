@@ -223,6 +223,8 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
   c.map.robot_id = static_cast<mapping::SourceId>(map.get_in_range("robot_id", 1, 1, 65535));
   c.map.start_heading_sigma_deg =
       map.get_in_range("start_heading_sigma_deg", c.map.start_heading_sigma_deg, 0.01, 180.0);
+  c.map.max_position_sigma_m =
+      map.get_in_range("max_position_sigma_m", c.map.max_position_sigma_m, 0.0, 1000.0);
   map.finish();
   // Read now: a wrong model path must stop start-up, not leave the robot running without a map.
   try {

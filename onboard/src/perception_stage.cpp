@@ -92,7 +92,8 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
                                  common::SpscRing<common::ImageFrame>* depth_frames,
                                  common::SpscRing<common::PointScan>* scans,
                                  const SharedPoseHistory& poses,
-                                 common::SpscRing<common::LabeledCloud>& clouds)
+                                 common::SpscRing<common::LabeledCloud>& clouds,
+                                 double max_position_sigma_m)
     : camera_(camera),
       depth_(depth),
       segmenter_(std::move(segmenter)),
@@ -101,6 +102,7 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
       scan_ring_(scans),
       poses_(poses),
       cloud_ring_(clouds),
+      max_position_sigma_m_(max_position_sigma_m),
       body_from_optical_(camera.body_from_optical()) {
   if (!segmenter_) throw std::invalid_argument("perception stage: no segmenter");
   if (depth_.source == DepthSource::kAligned && !depth_ring_) {
@@ -354,6 +356,10 @@ bool PerceptionStage::pose_clouds() {
       unposed_.pop_front();
       continue;
     }
+    if (too_uncertain(lookup.pose)) {
+      unposed_.pop_front();
+      continue;
+    }
     common::LabeledCloud cloud =
         mapping::transform_cloud(std::move(unposed_.front().cloud), lookup.pose.world_from_body());
     const common::Stamp stamp = cloud.stamp;
@@ -364,6 +370,28 @@ bool PerceptionStage::pose_clouds() {
     latency_.record(common::seconds_between(common::Stamp::now(), stamp));
   }
   return any;
+}
+
+// Counts a cloud whose pose is too uncertain to map, and logs when mapping pauses and resumes.
+bool PerceptionStage::too_uncertain(const estimation::StampedPose& pose) {
+  if (max_position_sigma_m_ <= 0.0) return false;
+  auto& figures = stage_.figures();
+  const bool uncertain = pose.position_sigma_m > max_position_sigma_m_;
+  if (uncertain && !paused_) {
+    common::logger("perception")
+        ->warn(
+            "mapping paused: the filter's position sigma {:.2f} m is above "
+            "map.max_position_sigma_m {:.2f} m",
+            pose.position_sigma_m, max_position_sigma_m_);
+    uncertain_at_pause_ = figures.uncertain_pose;
+  } else if (!uncertain && paused_) {
+    common::logger("perception")
+        ->info("mapping resumed: position sigma {:.2f} m ({} clouds dropped while paused)",
+               pose.position_sigma_m, figures.uncertain_pose - uncertain_at_pause_);
+  }
+  paused_ = uncertain;
+  if (uncertain) ++figures.uncertain_pose;
+  return uncertain;
 }
 
 void PerceptionStage::share_stats() { stage_.share(); }

@@ -74,7 +74,8 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
           config_.camera, config_.depth,
           make_segmenter(config_.segmenter, config_.map.params.num_classes), colour_ring_,
           source == DepthSource::kAligned ? &depth_ring_ : nullptr,
-          source == DepthSource::kLidar ? &scan_ring_ : nullptr, poses_, cloud_ring_);
+          source == DepthSource::kLidar ? &scan_ring_ : nullptr, poses_, cloud_ring_,
+          config_.map.max_position_sigma_m);
       log->info("perception: {}", perception_->describe());
     } catch (const std::exception& e) {
       log->error("perception disabled, running without a map: {}", e.what());
@@ -207,7 +208,8 @@ bool Pipeline::has_taken(const HandedOver& handed) const {
   if (e.imu_samples < handed.imu_samples || e.gnss_fixes < handed.gnss_fixes) return false;
   if (!perception_) return true;
   const auto p = perception_->stats();
-  const auto done = p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose;
+  const auto done =
+      p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose + p.uncertain_pose;
   // One cloud in the ring (capacity depth.ring >= 2) and none dropped: the same map as when
   // waiting for each insert, at the pace of the slower stage instead of the sum of both.
   return p.frames == handed.frames && done == p.frames &&

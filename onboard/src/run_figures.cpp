@@ -30,10 +30,11 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
   };
   if (perception) {
     // Colour frames lost anywhere before the map: in the driver's ring, passed over,
-    // unpaired, unreadable or without a pose.
+    // unpaired, unreadable, without a pose or posed too uncertainly.
     const auto p = perception->stats();
     figures.push_back({"perception", p.clouds, perception->queue_depth(),
-                       drops(r.colour) + p.skipped + p.unpaired + p.bad_frames + p.without_pose,
+                       drops(r.colour) + p.skipped + p.unpaired + p.bad_frames + p.without_pose +
+                           p.uncertain_pose,
                        perception->latency().percentiles()});
   }
   return figures;

@@ -17,9 +17,10 @@ void perception_summary(const PerceptionStage& perception, std::vector<std::stri
   const auto lat = perception.latency().percentiles();
   lines.push_back(
       fmt::format("perception       : {} frames, {} clouds mapped ({} points), {} passed over, "
-                  "{} unpaired, {} bad, {} without a pose; segment mean {:.1f} ms max {:.1f} ms; "
-                  "latency p50 {:.1f} ms p99 {:.1f} ms",
+                  "{} unpaired, {} bad, {} without a pose, {} posed too uncertainly; segment mean "
+                  "{:.1f} ms max {:.1f} ms; latency p50 {:.1f} ms p99 {:.1f} ms",
                   p.frames, p.clouds, p.points, p.skipped, p.unpaired, p.bad_frames, p.without_pose,
+                  p.uncertain_pose,
                   p.clouds ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
                   1e3 * p.segment_seconds_max, static_cast<double>(lat.p50_ms),
                   static_cast<double>(lat.p99_ms)));

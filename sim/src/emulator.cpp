@@ -42,6 +42,12 @@ bool Emulator::silenced(common::Stamp stamp) const {
   return phase >= f.silence_every_s - f.silence_duration_s;
 }
 
+bool Emulator::within(common::Stamp stamp, double at_s, double duration_s) const {
+  if (duration_s <= 0.0) return false;
+  const double t = seconds_between(stamp, first_stamp_);
+  return t >= at_s && t < at_s + duration_s;
+}
+
 void Emulator::run(SensorSource& source, const std::atomic<bool>* stop) {
   timespec wall_start{};
   bool paced = false;
@@ -200,8 +206,12 @@ void Emulator::emit_gnss(const common::GnssFix& truth) {
     ++stats_.injected.silenced_gnss_epochs;
     return;
   }
+  if (within(truth.stamp, f.gnss_silent_at_s, f.gnss_silent_s)) {
+    ++stats_.injected.gnss_silent_epochs;
+    return;
+  }
   common::GnssFix fix = truth;
-  if (chance(f.gnss_jump)) {
+  if (within(truth.stamp, f.gnss_jump_at_s, f.gnss_jump_s) || chance(f.gnss_jump)) {
     fix.latitude_deg += f.gnss_jump_m / kMetersPerDegreeLat;
     ++stats_.injected.gnss_jumps;
   }

@@ -103,15 +103,16 @@ std::string confusion_rows(const mapping::ConfusionMatrix& confusion) {
 
 }  // namespace
 
+Eigen::Vector3d sim_from_map(const SimRig& rig, const estimation::Geodetic& anchor) {
+  return estimation::LocalEnu(rig.data().origin).to_enu(anchor);
+}
+
 std::optional<PoseVsTruth> pose_vs_truth(const SimRig& rig,
                                          const onboard::EstimationStageStats& s) {
   if (!s.initialised || !s.latest || !s.anchor) return std::nullopt;
   const auto truth = rig.truth_at(s.latest->stamp);
   if (!truth) return std::nullopt;
-  const estimation::LocalEnu sim_frame(rig.data().origin);
-  // The filter's frame is anchored at its first good fix (and shifted by re-anchoring).
-  const Eigen::Vector3d anchor = sim_frame.to_enu(*s.anchor);
-  return PoseVsTruth{s.latest->position + anchor - s.anchor_offset, truth->state.position,
+  return PoseVsTruth{s.latest->position + sim_from_map(rig, *s.anchor), truth->state.position,
                      s.latest->stamp};
 }
 
@@ -201,9 +202,7 @@ mapping::ConfusionMatrix SimReport::map_confusion(
     const mapping::SemanticMap& map, const onboard::EstimationStageStats& final) const {
   mapping::ConfusionMatrix confusion(kSimMapClasses);
   if (!final.anchor) return confusion;
-  const estimation::LocalEnu sim_frame(rig_.data().origin);
-  const Eigen::Vector3f map_to_sim =
-      (sim_frame.to_enu(*final.anchor) - final.anchor_offset).cast<float>();
+  const Eigen::Vector3f map_to_sim = sim_from_map(rig_, *final.anchor).cast<float>();
   const auto& params = map.params();
   // A cell is on a surface when the surface passes through it: within its half-diagonal.
   const auto tolerance = static_cast<float>(params.resolution * std::sqrt(3.0) / 2.0);
@@ -306,14 +305,13 @@ void SimReport::write_trajectory_png(std::optional<double> rmse) const {
 
 void SimReport::write_truth_csv(const onboard::EstimationStageStats& final) const {
   if (!final.anchor) return;
-  const estimation::LocalEnu sim_frame(rig_.data().origin);
-  const Eigen::Vector3d sim_from_map = sim_frame.to_enu(*final.anchor) - final.anchor_offset;
+  const Eigen::Vector3d map_to_sim = sim_from_map(rig_, *final.anchor);
   std::ofstream out(dir_ / "truth.csv");
   out << "stamp_s,x,y,z\n";
   char line[128];
   for (const auto& t : rig_.data().truth) {
     const std::int64_t ns = rig_.started_at().ns + t.stamp.ns;
-    const Eigen::Vector3d p = t.state.position - sim_from_map;
+    const Eigen::Vector3d p = t.state.position - map_to_sim;
     std::snprintf(line, sizeof line, "%" PRId64 ".%09" PRId64 ",%.6f,%.6f,%.6f\n",
                   ns / 1'000'000'000, ns % 1'000'000'000, p.x(), p.y(), p.z());
     out << line;

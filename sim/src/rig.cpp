@@ -1,5 +1,7 @@
 #include "semap/sim/rig.hpp"
 
+#include <spdlog/fmt/fmt.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -44,6 +46,7 @@ SimRig::SimRig(const onboard::OnboardConfig& config, const SimRigConfig& sim,
                const onboard::SensorRings& rings)
     : duration_s_(config.rig.duration_s > 0 ? config.rig.duration_s : 1e12),
       camera_period_s_(1.0 / config.camera.driver.fps),
+      faults_(sim.faults),
       imu_ring_(rings.imu),
       data_(simulate_drive(config, sim)),
       world_(path_of(data_), world_options(sim)),
@@ -77,6 +80,7 @@ SimRig::SimRig(const onboard::OnboardConfig& config, const SimRigConfig& sim,
   // Shown on a V4L2 output, the colour frames come back through the camera's driver.
   if (!sim.camera_output.empty()) drivers_.add_camera(config.camera.driver, rings.colour);
   sim::EmulatorConfig emu;
+  emu.faults = sim.faults;
   emu.gnss_protocol = config.gnss.protocol;
   emu.speed = 0.0;  // the rig paces events itself
   auto gnss = config.gnss.driver;
@@ -133,6 +137,23 @@ void SimRig::stop() {
   }
   camera_->stop();
   drivers_.stop();
+}
+
+void SimRig::summary(std::vector<std::string>& lines) const {
+  // After stop(): the emulator's counters belong to the rig's thread while it runs.
+  const auto& injected = emulator_->stats().injected;
+  if (faults_.gnss_silent_s > 0.0) {
+    lines.push_back(
+        fmt::format("fault injected   : GNSS silent from {:.1f} s for {:.1f} s, {} epochs "
+                    "not sent",
+                    faults_.gnss_silent_at_s, faults_.gnss_silent_s, injected.gnss_silent_epochs));
+  }
+  if (faults_.gnss_jump_s > 0.0) {
+    lines.push_back(fmt::format(
+        "fault injected   : GNSS {:.1f} m north from {:.1f} s for {:.1f} s, "
+        "{} epochs offset",
+        faults_.gnss_jump_m, faults_.gnss_jump_at_s, faults_.gnss_jump_s, injected.gnss_jumps));
+  }
 }
 
 std::optional<estimation::TruthSample> SimRig::truth_at(common::Stamp stamp) const {

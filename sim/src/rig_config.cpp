@@ -25,11 +25,35 @@ void read_keys(const ConfigSection& s, SimRigConfig& rig) {
   rig.camera_output = s.get<std::string>("camera_output", "");
 }
 
+// rig.faults: scheduled windows; a window needs both its start and its length.
+void read_faults(const ConfigSection& rig, FaultConfig& f) {
+  const auto s = rig.section_or_empty("faults");
+  constexpr double kLongest = 1e6;  // s: longer than any drive
+  const auto window = [&s](const std::string& name, double& at, double& duration) {
+    at = s.get_in_range(name + "_at_s", 0.0, 0.0, kLongest);
+    duration = s.get_in_range(name + "_s", 0.0, 0.0, kLongest);
+    if (s.has(name + "_at_s") && duration <= 0.0) {
+      s.reject(name + "_at_s", "needs " + name + "_s > 0 (how long the fault lasts)");
+    }
+  };
+  window("gnss_silent", f.gnss_silent_at_s, f.gnss_silent_s);
+  window("gnss_jump", f.gnss_jump_at_s, f.gnss_jump_s);
+  f.gnss_jump_m = s.get_in_range("gnss_jump_m", f.gnss_jump_m, -1e4, 1e4);
+  if (s.has("gnss_jump_m") && f.gnss_jump_s <= 0.0) {
+    s.reject("gnss_jump_m", "needs gnss_jump_s > 0 (the window the offset applies in)");
+  }
+  s.finish();
+}
+
 }  // namespace
 
 onboard::RigKeys sim_rig_keys(SimRigConfig& out) {
   return [&out](const ConfigSection& rig, const ConfigSection& root, onboard::OnboardConfig& c) {
     read_keys(rig, out);
+    read_faults(rig, out.faults);
+    if (rig.has("faults") && c.rig.kind != onboard::RigKind::kSim) {
+      rig.reject("faults", "only the simulated rig injects faults");
+    }
     if (c.rig.kind == onboard::RigKind::kSim && c.depth.source != onboard::DepthSource::kAligned) {
       root.section_or_empty("depth").reject("source",
                                             "the simulated rig renders aligned depth only");

@@ -220,6 +220,8 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
        "estimator.anchor", "|lat| <= 90"},
       {"  resolution: 0.2\n  block_depth", "  resolution: -1\n  block_depth", "map.resolution", ""},
       {"  checkpoint_s: 10", "  checkpoint_s: -1", "map.checkpoint_s", "out of range"},
+      {"  max_position_sigma_m: 1.0 ", "  max_position_sigma_m: -1 ", "map.max_position_sigma_m",
+       "out of range"},
       {"  domain: 0", "  domain: 300", "dds.domain", "out of range"},
       {"  publish_hz: 2\n  cloud_hz", "  publish_hz: 0\n  cloud_hz", "dds.publish_hz",
        "out of range"},
@@ -251,6 +253,44 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
     EXPECT_EQ(error.rfind(named, 0), 0u) << "want " << named << "\ngot  " << error;
     EXPECT_NE(error.find(c.why), std::string::npos) << error;
   }
+}
+
+// rig.faults: the simulated rig's scheduled GNSS faults, each window with its start and length.
+TEST(OnboardConfig, SimulatedRigFaults) {
+  sim::SimRigConfig none;
+  const auto c = load(kConfigDir / "sim.yaml", &none);
+  EXPECT_DOUBLE_EQ(c.map.max_position_sigma_m, 1.0);
+  EXPECT_DOUBLE_EQ(none.faults.gnss_silent_s, 0.0);
+  EXPECT_DOUBLE_EQ(none.faults.gnss_jump_s, 0.0);
+  const std::string faults =
+      "  kind: sim\n  faults:\n    gnss_silent_at_s: 25\n    gnss_silent_s: 30\n"
+      "    gnss_jump_at_s: 65\n    gnss_jump_s: 5\n    gnss_jump_m: -40\n";
+  const auto path = edited_sim("  kind: sim\n", faults);
+  sim::SimRigConfig sim_rig;
+  load(path, &sim_rig);
+  std::filesystem::remove(path);
+  EXPECT_DOUBLE_EQ(sim_rig.faults.gnss_silent_at_s, 25.0);
+  EXPECT_DOUBLE_EQ(sim_rig.faults.gnss_silent_s, 30.0);
+  EXPECT_DOUBLE_EQ(sim_rig.faults.gnss_jump_at_s, 65.0);
+  EXPECT_DOUBLE_EQ(sim_rig.faults.gnss_jump_s, 5.0);
+  EXPECT_DOUBLE_EQ(sim_rig.faults.gnss_jump_m, -40.0);
+  const std::vector<std::pair<std::string, std::string>> bad{
+      {"  faults: {gnss_silent_at_s: 25}", "'rig.faults.gnss_silent_at_s': needs gnss_silent_s"},
+      {"  faults: {gnss_jump_m: 50}", "'rig.faults.gnss_jump_m': needs gnss_jump_s"},
+      {"  faults: {gnss_silent_s: -1}", "'rig.faults.gnss_silent_s'"},
+      {"  faults: {gnss_jump_at_s: 5, gnss_jump_s: 1, gnss_jump_m: 1e5}",
+       "'rig.faults.gnss_jump_m'"},
+      {"  faults: {gnss_silence_s: 30}", "'rig.faults.gnss_silence_s': unknown key"},
+      {"  faults: 30", "'rig.faults': expected a mapping"},
+  };
+  for (const auto& [with, why] : bad) {
+    const std::string error = error_of(edited_sim("  kind: sim\n", "  kind: sim\n" + with + "\n"));
+    EXPECT_NE(error.find(why), std::string::npos) << with << "\n" << error;
+  }
+  // Only the simulated rig has an emulator to put faults in.
+  const std::string hardware = error_of(edited_sim(
+      "  kind: sim\n", "  kind: hardware\n  faults: {gnss_silent_at_s: 1, gnss_silent_s: 1}\n"));
+  EXPECT_NE(hardware.find("only the simulated rig injects faults"), std::string::npos) << hardware;
 }
 
 // `dnn` names any network OpenCV reads; `onnx`, the only format once, stays a name for it.

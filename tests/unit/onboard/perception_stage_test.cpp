@@ -85,14 +85,14 @@ class PerceptionStageTest : public ::testing::Test {
     depth_.points.max_range = 20.0f;
   }
 
-  std::unique_ptr<PerceptionStage> make_stage() {
+  std::unique_ptr<PerceptionStage> make_stage(double max_position_sigma_m = 0.0) {
     perception::PaletteOptions options;
     options.confidence = 0.8f;
     return std::make_unique<PerceptionStage>(
         camera_, depth_,
         std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(), kClasses,
                                                        options),
-        colour_, &depth_ring_, nullptr, poses_, clouds_);
+        colour_, &depth_ring_, nullptr, poses_, clouds_, max_position_sigma_m);
   }
 
   void push_pair(double t, std::uint32_t sequence) {
@@ -164,6 +164,40 @@ TEST_F(PerceptionStageTest, CountsFramesWithoutAPose) {
   EXPECT_TRUE(clouds_.empty());
   EXPECT_EQ(stage->stats().without_pose, 2u);
   EXPECT_EQ(stage->stats().clouds, 0u);
+}
+
+// map.max_position_sigma_m: a frame posed while the filter's position sigma is above the limit
+// is dropped and counted; mapping resumes with the first pose below it.
+TEST_F(PerceptionStageTest, DropsCloudsPosedTooUncertainly) {
+  auto stage = make_stage(1.0);
+  auto poses = drive(1.0, 4.0);
+  // The sigma grows from 0.2 m to 3.2 m over 1..2.5 s (an outage), then a fix brings it back.
+  for (auto& p : poses) {
+    const double t = p.stamp.seconds();
+    p.position_sigma_m = t < 2.5 ? 0.2 + 2.0 * (t - 1.0) : 0.3;
+  }
+  poses_.append(poses);
+  std::uint32_t sequence = 0;
+  for (const double t : {1.2, 1.35, 1.6, 2.0, 2.49, 2.6, 3.0}) {
+    push_pair(t, ++sequence);
+    while (stage->step()) {
+    }
+  }
+  const auto s = stage->stats();
+  EXPECT_EQ(s.uncertain_pose, 3u);  // sigma 1.4, 2.2 and 3.18 m
+  EXPECT_EQ(s.clouds, 4u);          // 0.6, 0.9 m; 0.3 m after the fix
+  EXPECT_EQ(s.without_pose, 0u);
+  std::vector<float> mapped;
+  LabeledCloud cloud;
+  while (clouds_.try_pop(cloud)) mapped.push_back(static_cast<float>(cloud.stamp.seconds()));
+  EXPECT_EQ(mapped, (std::vector<float>{1.2f, 1.35f, 2.6f, 3.0f}));
+  // Off (0): every posed frame is mapped whatever the sigma.
+  auto unlimited = make_stage(0.0);
+  push_pair(2.0, ++sequence);
+  while (unlimited->step()) {
+  }
+  EXPECT_EQ(unlimited->stats().uncertain_pose, 0u);
+  EXPECT_EQ(unlimited->stats().clouds, 1u);
 }
 
 TEST_F(PerceptionStageTest, TakesTheNewestFrameWhenBehind) {

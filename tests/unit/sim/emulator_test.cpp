@@ -172,6 +172,61 @@ TEST_P(EmulatorSeed, NmeaIntoARealPtyWithEveryFaultCountedExactly) {
   EXPECT_GE(off_track + inj.truncated, inj.gnss_jumps);
 }
 
+// Scheduled windows in sensor time: a 3 s GNSS silence while the IMU keeps sending, then 2 s of
+// fixes offset 50 m north. Each epoch is counted, and the fixes that arrive say which is which.
+TEST(Emulator, ScheduledGnssSilenceAndJumpWindows) {
+  Pty pty;
+  EmulatorConfig config;
+  config.serial_fd = pty.master;
+  config.can_sink = [](const SemapCanFrame&) {};  // a CAN link without a bus
+  config.speed = 0.0;
+  config.faults.gnss_silent_at_s = 5.0;
+  config.faults.gnss_silent_s = 3.0;
+  config.faults.gnss_jump_at_s = 12.0;
+  config.faults.gnss_jump_s = 2.0;
+  config.faults.gnss_jump_m = 50.0;
+  Emulator emulator(config);
+  GnssStreamDecoder decoder;
+  std::vector<common::GnssFix> fixes;
+  std::atomic<bool> done{false};
+  std::thread reader([&] { read_gnss(pty.slave, done, decoder, fixes); });
+  const ConstantTurnConfig c = turn(20.0);
+  ConstantTurnSource source(c);
+  emulator.run(source);
+  done = true;
+  reader.join();
+
+  const EmulatorStats& st = emulator.stats();
+  EXPECT_EQ(st.injected.gnss_silent_epochs, 30u);  // [5, 8) s at 10 Hz
+  EXPECT_EQ(st.injected.gnss_jumps, 20u);          // [12, 14) s
+  EXPECT_EQ(st.gnss_epochs, 200u - 30u);
+  EXPECT_EQ(st.imu_samples, 8000u) << "the IMU keeps sending through the silence";
+  ASSERT_EQ(fixes.size(), st.gnss_epochs);
+  // The first event is the IMU sample at t = 0; fixes carry their sensor time as UTC.
+  const double m_per_deg_lat = 111'200.0;
+  const double radius = c.speed_mps / c.yaw_rate_rad_s;
+  const double m_per_deg_lon = m_per_deg_lat * std::cos(c.origin_lat_deg * std::numbers::pi / 180);
+  int jumped = 0;
+  for (const auto& fix : fixes) {
+    ASSERT_TRUE(fix.utc_ns.has_value());
+    const double t = static_cast<double>(*fix.utc_ns / 1'000'000 - config.utc_start_unix_ms) / 1e3;
+    EXPECT_FALSE(t >= 5.0 - 1e-6 && t < 8.0 - 1e-6) << "a fix inside the silence at " << t;
+    const double east = (fix.longitude_deg - c.origin_lon_deg) * m_per_deg_lon;
+    const double north = (fix.latitude_deg - c.origin_lat_deg) * m_per_deg_lat;
+    const double off = std::hypot(east, north - radius) - radius;
+    const bool in_jump = t >= 12.0 - 1e-6 && t < 14.0 - 1e-6;
+    if (in_jump) {
+      ++jumped;
+      // 50 m north of a point on the circle: off the circle by up to 50 m.
+      const double north_back = north - 50.0 * m_per_deg_lat / 111'320.0;
+      EXPECT_NEAR(std::hypot(east, north_back - radius), radius, 0.5) << t;
+    } else {
+      EXPECT_NEAR(off, 0.0, 0.5) << t;
+    }
+  }
+  EXPECT_EQ(jumped, 20);
+}
+
 TEST_P(EmulatorSeed, UbxIntoARealPtyCountsCutFramesOnce) {
   Pty pty;
   EmulatorConfig config;

@@ -27,6 +27,8 @@ struct EstimatorCounters {
   std::uint64_t velocity_applied = 0;
   std::uint64_t velocity_rejected = 0;
   std::uint64_t reanchors = 0;
+  // Of those, back to a frame used before (a multipath jump that ended): that frame restored.
+  std::uint64_t reanchors_back = 0;
   std::uint64_t position_inflations = 0;  // overconfident or diverged filter recovered
   std::uint64_t init_not_static = 0;      // initialised from a window that was not at rest
 };
@@ -91,6 +93,7 @@ class Estimator {
   PoseHistory history_;
   std::optional<LocalEnu> local_;
   Eigen::Vector3d anchor_offset_ = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> earlier_offsets_;  // before each re-anchoring, oldest first
   mutable EstimatorCounters counters_;
 
   std::deque<QueuedImu> imu_queue_;

@@ -15,6 +15,9 @@ struct StampedPose {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // body to world
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  // The filter's position uncertainty at this pose, 1 sigma along its least certain axis (m,
+  // position_sigma_m below); 0 when nobody estimated it (poses a dataset gives).
+  double position_sigma_m = 0.0;
 
   // World from body, for transforming what the robot sensed at this pose.
   Eigen::Isometry3f world_from_body() const {
@@ -25,8 +28,13 @@ struct StampedPose {
   }
 };
 
+// 1 sigma along the least certain axis of a position covariance (m^2): the square root of its
+// largest eigenvalue.
+double position_sigma_m(const Eigen::Matrix3d& covariance);
+
 // The last `capacity` filter poses in a ring, for interpolating the pose at a sensor stamp
-// (slerp for the orientation, linear for position and velocity).
+// (slerp for the orientation, linear for position and velocity; the larger position sigma of
+// the two poses around the stamp).
 class PoseHistory {
  public:
   explicit PoseHistory(std::size_t capacity);

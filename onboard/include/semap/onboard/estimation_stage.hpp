@@ -27,6 +27,7 @@ struct EstimationStageStats {
   std::optional<common::Stamp> heading_settled;
   bool initialised = false;
   estimation::EstimatorCounters estimator;
+  // The filter's state, with its position sigma as last read (see EstimationStage).
   std::optional<estimation::StampedPose> latest;
   std::optional<estimation::Geodetic> anchor;
   Eigen::Vector3d anchor_offset = Eigen::Vector3d::Zero();
@@ -52,7 +53,10 @@ struct EstimationStageConfig {
 
 // Owns the Estimator on its own thread: drains the IMU and GNSS rings in stamp order and
 // shares the filter's poses with the perception stage, which poses frames at their stamps,
-// once the filter's heading has settled (map.start_heading_sigma_deg).
+// once the filter's heading has settled (map.start_heading_sigma_deg). Each pose carries the
+// filter's position sigma (estimation::position_sigma_m of its position covariance), read 20
+// times per second of filter time and after every GNSS correction or covariance inflation (the
+// InEKF forms its covariance on demand; between reads a pose carries the last one).
 class EstimationStage {
  public:
   using PoseSink = std::function<void(const PoseOutput&)>;
@@ -75,6 +79,7 @@ class EstimationStage {
   bool drain_sensors();
   void publish_pose();
   void check_heading();
+  double position_sigma();
   void share_stats();
 
   EstimationStageConfig config_;
@@ -86,6 +91,9 @@ class EstimationStage {
   std::vector<estimation::StampedPose> new_poses_;
   std::unique_ptr<TrajectoryLog> trajectory_;
   common::Stamp next_heading_check_;
+  common::Stamp next_sigma_read_;
+  std::uint64_t sigma_read_at_corrections_ = 0;  // GNSS corrections and inflations then
+  double position_sigma_m_ = 0.0;
   common::ImuSample last_imu_;
   common::Stamp next_pose_publish_;
   common::LatencyWindow imu_latency_;

@@ -92,6 +92,10 @@ struct MappingConfig {
   // Frames are mapped only once the filter's heading is known to within this (1 sigma):
   // a filter that starts from a guessed heading would otherwise smear the map.
   double start_heading_sigma_deg = 3.0;
+  // Clouds posed while the filter's position sigma (1 sigma, least certain axis) is above this
+  // are not mapped: mapping pauses through a long GNSS outage and resumes when fixes return.
+  // 0 turns the check off.
+  double max_position_sigma_m = 1.0;
 };
 
 // realtime: process-wide real-time practice (each driver's thread has its own

@@ -32,8 +32,11 @@ struct PerceptionStageStats {
   std::uint64_t partner_unused = 0;  // depth frames (LiDAR mode: colour frames) left unpaired
   std::uint64_t bad_frames = 0;      // undecodable, wrong format or wrong size
   std::uint64_t without_pose = 0;    // before the filter started, or older than its history
-  std::uint64_t points = 0;          // labelled points handed on
-  perception::DropCounts dropped;    // pixels dropped on the way to points, by reason
+  // Posed while the filter's position sigma was above map.max_position_sigma_m (a GNSS outage):
+  // mapping pauses rather than smear the map.
+  std::uint64_t uncertain_pose = 0;
+  std::uint64_t points = 0;        // labelled points handed on
+  perception::DropCounts dropped;  // pixels dropped on the way to points, by reason
   double segment_seconds_total = 0.0;
   double segment_seconds_max = 0.0;
 };
@@ -42,7 +45,10 @@ struct PerceptionStageStats {
 // frames of a separate depth device, or LiDAR scans) from the drivers' rings, pairs them by
 // stamp, segments, turns labelled pixels with depth (or scan points projected into the
 // segmented image) into points in the body frame, poses them at the frame's stamp from the
-// estimation stage's history and hands the cloud to the mapping stage.
+// estimation stage's history and hands the cloud to the mapping stage, unless the pose's
+// position sigma is above `max_position_sigma_m` (> 0; map.max_position_sigma_m): such a cloud
+// is dropped and counted (uncertain_pose), so mapping pauses while the filter is unsure where
+// it is and resumes when it knows again.
 // It keeps only the newest frame when it falls behind: drivers never wait for it.
 class PerceptionStage {
  public:
@@ -51,7 +57,8 @@ class PerceptionStage {
                   common::SpscRing<common::ImageFrame>& colour,
                   common::SpscRing<common::ImageFrame>* depth_frames,
                   common::SpscRing<common::PointScan>* scans, const SharedPoseHistory& poses,
-                  common::SpscRing<common::LabeledCloud>& clouds);
+                  common::SpscRing<common::LabeledCloud>& clouds,
+                  double max_position_sigma_m = 0.0);
   ~PerceptionStage();
   PerceptionStage(const PerceptionStage&) = delete;
   PerceptionStage& operator=(const PerceptionStage&) = delete;
@@ -101,6 +108,7 @@ class PerceptionStage {
   perception::Segmentation segment(const common::ImageFrame& colour, const cv::Mat& image);
   void queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp, std::uint32_t sequence);
   bool pose_clouds();
+  bool too_uncertain(const estimation::StampedPose& pose);
   void reject(const std::string& frame, const std::string& why);
   void share_stats();
 
@@ -117,6 +125,9 @@ class PerceptionStage {
   bool whole_scans_ = false;
   const SharedPoseHistory& poses_;
   common::SpscRing<common::LabeledCloud>& cloud_ring_;
+  double max_position_sigma_m_;
+  bool paused_ = false;  // the last cloud's pose was too uncertain
+  std::uint64_t uncertain_at_pause_ = 0;
   Eigen::Isometry3f body_from_optical_;
   drivers::JpegDecoder jpeg_;
   std::deque<common::ImageFrame> colour_pending_;

@@ -13,7 +13,8 @@
 namespace semap::sim {
 
 // Fault probabilities are per IMU sample (CAN faults) or per GNSS epoch (serial faults). At most
-// one CAN fault hits a sample, so a receiver's counters can be compared exactly.
+// one CAN fault hits a sample, so a receiver's counters can be compared exactly. Scheduled windows
+// are in sensor time from the first event, [at_s, at_s + s); a window of 0 s is off.
 struct FaultConfig {
   double crc_error = 0.0;     // one frame of the sample gets a wrong CRC byte
   double drop_frame = 0.0;    // one frame of the sample is not sent
@@ -27,6 +28,12 @@ struct FaultConfig {
   // counting, as with a loose connector). Zero disables.
   double silence_every_s = 0.0;
   double silence_duration_s = 0.0;
+  // The GNSS receiver sends nothing (a tunnel, a lost antenna); the IMU keeps going.
+  double gnss_silent_at_s = 0.0;
+  double gnss_silent_s = 0.0;
+  // Every epoch's position is offset north by gnss_jump_m (multipath off a wall).
+  double gnss_jump_at_s = 0.0;
+  double gnss_jump_s = 0.0;
   std::uint32_t seed = 1;
 };
 
@@ -38,9 +45,10 @@ struct InjectedFaults {
   std::uint64_t garbage_bursts = 0;
   std::uint64_t garbage_bytes = 0;
   std::uint64_t truncated = 0;
-  std::uint64_t gnss_jumps = 0;
+  std::uint64_t gnss_jumps = 0;  // epochs offset north: at random (gnss_jump) or scheduled
   std::uint64_t silenced_imu_samples = 0;
-  std::uint64_t silenced_gnss_epochs = 0;
+  std::uint64_t silenced_gnss_epochs = 0;  // silence_every_s
+  std::uint64_t gnss_silent_epochs = 0;    // the scheduled GNSS silence
 };
 
 struct EmulatorStats {
@@ -95,6 +103,7 @@ class Emulator {
   void send_can(const SemapCanFrame& frame);
   void send_serial(const void* data, std::size_t len);
   bool silenced(common::Stamp stamp) const;
+  bool within(common::Stamp stamp, double at_s, double duration_s) const;
   bool chance(double probability);
   void send_garbage();
 

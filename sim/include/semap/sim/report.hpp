@@ -25,6 +25,11 @@ class SemanticMap;
 
 namespace semap::sim {
 
+// Where the map frame's origin (the filter's anchor) lies in the simulator's ENU frame. The
+// filter's frame stays where it was anchored: a re-anchoring after a GNSS jump shifts the fixes
+// into it (EstimationStageStats::anchor_offset), not the frame, so the offset plays no part.
+Eigen::Vector3d sim_from_map(const SimRig& rig, const estimation::Geodetic& anchor);
+
 // The filter's live position and the rig's truth at its stamp, both in the simulator's frame;
 // nullopt before the filter initialised.
 struct PoseVsTruth {

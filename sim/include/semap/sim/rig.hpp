@@ -45,6 +45,8 @@ class SimRig final : public onboard::SensorRig {
   void stop() override;
   bool finished() const override { return finished_.load(std::memory_order_acquire); }
   const onboard::RigDrivers& drivers() const override { return drivers_; }
+  // The scheduled faults (rig.faults) and what they injected, when any is set.
+  void summary(std::vector<std::string>& lines) const override;
 
   // CLOCK_MONOTONIC of the simulated drive's time zero (set by start()).
   common::Stamp started_at() const { return start_; }
@@ -62,6 +64,7 @@ class SimRig final : public onboard::SensorRig {
 
   double duration_s_;
   double camera_period_s_;
+  FaultConfig faults_;
   common::SpscRing<common::ImuSample>& imu_ring_;
   estimation::DriveData data_;
   sim::SimWorld world_;

@@ -6,6 +6,7 @@
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/sim/camera_feed.hpp"
 #include "semap/sim/drive_simulator.hpp"
+#include "semap/sim/emulator.hpp"
 
 namespace semap::sim {
 
@@ -20,6 +21,9 @@ struct SimRigConfig {
   // frames there as BGR24 and a CameraDriver on camera.device captures them back. Empty: the
   // frames go straight into the colour ring.
   std::string camera_output;
+  // rig.faults: scheduled GNSS faults in the firmware emulator (seconds from the drive's first
+  // sample): gnss_silent_at_s / gnss_silent_s, gnss_jump_at_s / gnss_jump_s / gnss_jump_m.
+  FaultConfig faults;
 };
 
 // Reads the simulated rig's keys into `out` when load_onboard_config calls it, and checks the
