@@ -34,6 +34,21 @@ set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)  # semap_<version>_<arch>.deb
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+if(CMAKE_CROSSCOMPILING)
+  # A cross build (scripts/cross-arm64): the package is for the target's architecture, and
+  # dpkg-shlibdeps, run by CPack, would look the libraries up among the build machine's installed
+  # packages. scripts/package --arm64 runs it against the sysroot's arm64 packages instead and
+  # writes the Depends line to deb/depends, which cmake/SemapCPackCross.cmake reads at cpack time
+  # (a plain `cpack` before that fails rather than pack a package without dependencies).
+  if(CMAKE_SYSTEM_PROCESSOR STREQUAL "aarch64")
+    set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE arm64)
+  else()
+    message(FATAL_ERROR "SemapPackaging: no Debian architecture for ${CMAKE_SYSTEM_PROCESSOR}")
+  endif()
+  set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS OFF)
+  set(CPACK_SEMAP_DEPENDS_FILE ${CMAKE_BINARY_DIR}/deb/depends)
+  set(CPACK_PROJECT_CONFIG_FILE ${PROJECT_SOURCE_DIR}/cmake/SemapCPackCross.cmake)
+endif()
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "can-utils")
 # dpkg keeps an edited /etc/semap file across upgrades.
 file(WRITE ${CMAKE_BINARY_DIR}/deb/conffiles "/etc/semap/semap.yaml\n/etc/semap/cyclonedds.xml\n")

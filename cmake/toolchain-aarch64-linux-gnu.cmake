@@ -38,6 +38,12 @@ string(REPLACE ";" ":" semap_arm64_libpath "${semap_arm64_libdirs}")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-Wl,-rpath-link,${semap_arm64_libpath}")
 set(CMAKE_SHARED_LINKER_FLAGS_INIT "-Wl,-rpath-link,${semap_arm64_libpath}")
 
+# Debian keeps architecture-dependent headers in /usr/include/<triplet> (Cyclone DDS's
+# dds/features.h), a default include folder of the native compiler; the cross compiler searches
+# only its own, so the sysroot's is added to every compile.
+set(CMAKE_C_FLAGS_INIT "-isystem ${SEMAP_SYSROOT}/usr/include/${CMAKE_LIBRARY_ARCHITECTURE}")
+set(CMAKE_CXX_FLAGS_INIT "-isystem ${SEMAP_SYSROOT}/usr/include/${CMAKE_LIBRARY_ARCHITECTURE}")
+
 set(ENV{PKG_CONFIG_SYSROOT_DIR} ${SEMAP_SYSROOT})
 set(ENV{PKG_CONFIG_LIBDIR}
     "${SEMAP_SYSROOT}/usr/lib/aarch64-linux-gnu/pkgconfig:${SEMAP_SYSROOT}/usr/share/pkgconfig")
