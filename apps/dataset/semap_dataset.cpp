@@ -22,6 +22,7 @@
 #include "kitti_semantic_command.hpp"
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/map_io/kitti_semantic_eval.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/perception/datasets/kitti_odometry.hpp"
 #include "semap/perception/datasets/redwood.hpp"
@@ -72,17 +73,11 @@ mapping::MapParams rgbd_map() {
   return p;
 }
 
-// A Velodyne street scene at the S-BKI paper's parameters (ell 0.3, ds 0.1; free space
-// sampled sparsely), as semantickitti maps it, out to 30 m.
+// A Velodyne street scene at the S-BKI paper's parameters, as semantickitti maps it (ell 0.3,
+// ds 0.1), with free space sampled every 2 m and hits kept out to 30 m.
 mapping::MapParams lidar_map() {
-  mapping::MapParams p;
-  p.resolution = 0.1f;
-  p.block_depth = 3;
-  p.sf2 = 0.1f;
-  p.ell = 0.3f;
-  p.prior = 0.001f;
+  mapping::MapParams p = map_io::kitti_semantic_params();
   p.free_res = 2.0f;
-  p.ds_res = 0.1f;
   p.max_range = 30.0f;
   return p;
 }

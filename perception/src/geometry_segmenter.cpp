@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "input_image.hpp"
+
 namespace semap::perception {
 
 GeometrySegmenter::GeometrySegmenter(int num_classes) : num_classes_(num_classes) {
@@ -12,9 +14,7 @@ GeometrySegmenter::GeometrySegmenter(int num_classes) : num_classes_(num_classes
 }
 
 Segmentation GeometrySegmenter::segment(const cv::Mat& bgr) {
-  if (bgr.empty() || bgr.type() != CV_8UC3) {
-    throw std::invalid_argument("GeometrySegmenter: expects a non-empty CV_8UC3 image");
-  }
+  detail::require_bgr_image(bgr, "GeometrySegmenter::segment");
   Segmentation s;
   s.num_classes = num_classes_;
   s.labels = cv::Mat(bgr.size(), CV_16UC1, cv::Scalar(1));

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "input_image.hpp"
+
 namespace semap::perception {
 
 LabelImageSegmenter::LabelImageSegmenter(int num_classes) : num_classes_(num_classes) {
@@ -13,9 +15,7 @@ LabelImageSegmenter::LabelImageSegmenter(int num_classes) : num_classes_(num_cla
 }
 
 Segmentation LabelImageSegmenter::segment(const cv::Mat& bgr) {
-  if (bgr.empty() || bgr.type() != CV_8UC3) {
-    throw std::invalid_argument("LabelImageSegmenter: expects a non-empty CV_8UC3 image");
-  }
+  detail::require_bgr_image(bgr, "LabelImageSegmenter::segment");
   Segmentation s;
   s.num_classes = num_classes_;
   s.labels = cv::Mat(bgr.size(), CV_16UC1);
