@@ -5,7 +5,9 @@
 #include <sys/mman.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 
 namespace semap::drivers {
 
@@ -36,8 +38,28 @@ std::string set_cpu_affinity(std::span<const int> cpus) {
          (error == EINVAL ? " (no such CPU online, or outside this process's cpuset)" : "");
 }
 
+namespace {
+
+// The kernel's count of this process's locked memory (the VmLck line of /proc/self/status),
+// or -1 when it cannot be read.
+long locked_kib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmLck:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
+  }
+  return -1;
+}
+
+}  // namespace
+
 std::string lock_memory() {
-  if (::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) return {};
+  if (::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+    // Sanitizer runtimes intercept mlockall and return success without locking anything.
+    if (locked_kib() == 0)
+      return "mlockall refused: it returned success but the kernel locked 0 kB";
+    return {};
+  }
   const int error = errno;
   return std::string("mlockall refused: ") + std::strerror(error) +
          (error == ENOMEM || error == EPERM

@@ -244,6 +244,7 @@ TEST(DriverRealtime, LocksMemoryOrSaysWhyNot) {
     ::munlockall();
   } else {
     EXPECT_NE(refused.find("mlockall refused"), std::string::npos) << refused;
+    EXPECT_EQ(locked, "VmLck:\t       0 kB") << "refused, yet memory is locked: " << refused;
   }
 }
 

@@ -22,7 +22,8 @@ std::string set_cpu_affinity(std::span<const int> cpus);
 
 // Locks the process's pages in RAM, now and future (mlockall), so no page fault stalls a
 // driver or stage thread on a robot under memory pressure. Returns an empty string, or why it
-// was refused (RLIMIT_MEMLOCK too small; systemd: LimitMEMLOCK=infinity).
+// was refused (RLIMIT_MEMLOCK too small; systemd: LimitMEMLOCK=infinity), or that the kernel
+// locked nothing although mlockall returned success (as under a sanitizer runtime).
 std::string lock_memory();
 
 }  // namespace semap::drivers
