@@ -32,7 +32,7 @@ void print_health(const sd::HealthReport& h) {
               << " dropped " << d.dropped << " reconnects " << d.reconnects << " bus_off "
               << d.bus_off << " error_passive " << d.error_passive << " bus_restarts "
               << d.bus_restarts << " wakeup_p99 " << d.wakeup_p99_ms << " wakeup_max "
-              << d.wakeup_max_ms << " |";
+              << d.wakeup_max_ms << " longest_gap_s " << d.longest_gap_s << " |";
   }
   for (const auto& w : h.writers) {
     std::cout << " writer " << w.name << " writes " << w.writes << " failures " << w.failures

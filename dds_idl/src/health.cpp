@@ -12,7 +12,7 @@ HealthMessage::HealthMessage(const HealthReport& r, const std::string& frame_id)
   for (const auto& d : r.drivers) {
     drivers_.push_back({const_cast<char*>(d.name.c_str()), d.frames, d.bad_frames, d.dropped,
                         d.reconnects, d.bus_off, d.error_passive, d.bus_restarts, d.wakeup_p50_ms,
-                        d.wakeup_p99_ms, d.wakeup_max_ms});
+                        d.wakeup_p99_ms, d.wakeup_max_ms, d.longest_gap_s});
   }
   for (const auto& w : r.writers) {
     writers_.push_back({const_cast<char*>(w.name.c_str()), const_cast<char*>(w.path.c_str()),
@@ -40,7 +40,7 @@ HealthReport from_msg(const msg::Health& m) {
     const auto& d = m.drivers_._buffer[i];
     r.drivers.push_back({d.name_ ? d.name_ : "", d.frames_, d.bad_frames_, d.dropped_,
                          d.reconnects_, d.bus_off_, d.error_passive_, d.bus_restarts_,
-                         d.wakeup_p50_ms_, d.wakeup_p99_ms_, d.wakeup_max_ms_});
+                         d.wakeup_p50_ms_, d.wakeup_p99_ms_, d.wakeup_max_ms_, d.longest_gap_s_});
   }
   for (std::uint32_t i = 0; i < m.writers_._length; ++i) {
     const auto& w = m.writers_._buffer[i];

@@ -76,6 +76,8 @@ void MapPublisher::changed(const common::BlockIndex& index) {
   updates_due_ = true;
 }
 
+void MapPublisher::forget(const common::BlockIndex& index) { forgotten_.insert(index); }
+
 void MapPublisher::spin_updates(common::Stamp now) {
   if (now >= next_blocks_ && config_.cloud_hz > 0.0 && updates_due_) publish_cloud_updates(now);
 }
@@ -116,10 +118,28 @@ std::size_t MapPublisher::publish_changed(common::Stamp now) {
       ++counters_.write_timeouts;
       break;
     }
+    in_history_.insert(*it);
     it = changed_.erase(it);
     ++written;
   }
   block_writer_.flush();
+  // A forgotten block still waiting to go out (a write timed out) is forgotten after it went.
+  for (auto it = forgotten_.begin(); it != forgotten_.end();) {
+    if (changed_.contains(*it)) {
+      ++it;
+      continue;
+    }
+    if (in_history_.erase(*it) > 0) {
+      msg::SemanticMapBlock key{};
+      key.ix_ = it->x;
+      key.iy_ = it->y;
+      key.iz_ = it->z;
+      block_writer_.unregister(key);
+      ++counters_.blocks_forgotten;
+    }
+    sent_classes_.erase(*it);
+    it = forgotten_.erase(it);
+  }
   counters_.blocks_written += written;
   if (written > 0) ++counters_.block_publications;
   return written;

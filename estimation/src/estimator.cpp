@@ -116,7 +116,15 @@ void Estimator::process_imu(const QueuedImu& queued) {
     return;
   }
   if (queued.restart) {
-    filter_time_ = s.stamp;
+    if (last_imu_) {
+      bridge_gap(s.stamp);
+      ++counters_.imu_gaps_bridged;
+      last_imu_ = s;
+      record_pose();
+    } else {
+      filter_time_ = s.stamp;
+      last_imu_ = s;
+    }
     return;
   }
   // The sample holds over (filter_time_, s.stamp]; fixes inside it split the interval.
@@ -129,7 +137,32 @@ void Estimator::process_imu(const QueuedImu& queued) {
   const double dt = common::seconds_between(s.stamp, filter_time_);
   if (dt > 0.0) filter_->propagate(s.gyro, s.accel, dt);
   filter_time_ = s.stamp;
+  last_imu_ = s;
   record_pose();
+}
+
+// An IMU gap (a CAN bus gone off, a loose connector): the motion inside it was not measured.
+// Holding the last sample over it (zero-order hold) carries the state at the speed and turn
+// rate it had, in steps no longer than an IMU interval may be, to each fix inside the gap,
+// which corrects what the hold gets wrong; the process noise of the gap's length widens the
+// covariance meanwhile. Restarting the integration at the gap's end instead would leave the
+// state where the gap began, the vehicle's whole travel in the gap behind it.
+void Estimator::bridge_gap(common::Stamp to) {
+  constexpr double kStep = 0.01;  // s
+  const common::ImuSample held = *last_imu_;
+  const auto advance = [&](common::Stamp until) {
+    for (double left = common::seconds_between(until, filter_time_); left > 0.0;
+         left = common::seconds_between(until, filter_time_)) {
+      const double dt = std::min(kStep, left);
+      filter_->propagate(held.gyro, held.accel, dt);
+      filter_time_ = dt < left ? filter_time_ + dt : until;
+    }
+  };
+  while (auto fix = gnss_buffer_.pop_until(to)) {
+    advance(fix->stamp);
+    apply_gnss(*fix);
+  }
+  advance(to);
 }
 
 void Estimator::collect_init_sample(const common::ImuSample& sample) {

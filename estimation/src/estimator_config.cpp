@@ -60,7 +60,8 @@ EstimatorConfig load_estimator_config(const common::ConfigSection& s) {
   c.imu_limits.max_accel_m_s2 =
       s.get_in_range("imu_max_accel", c.imu_limits.max_accel_m_s2, 10.0, 2000.0);
   c.imu_delay_s = s.get_in_range("imu_delay", c.imu_delay_s, 0.0, 1.0);
-  c.gnss_buffer = static_cast<std::size_t>(s.get_in_range("gnss_buffer", 16, 1, 1024));
+  c.gnss_buffer = static_cast<std::size_t>(
+      s.get_in_range("gnss_buffer", static_cast<int>(c.gnss_buffer), 1, 1024));
   c.history = static_cast<std::size_t>(s.get_in_range("history", 2048, 2, 1e6));
   c.init.window_s = s.get_in_range("init_window", c.init.window_s, 0.05, 30.0);
   c.init.yaw_rad = s.get_in_range("init_yaw_deg", 0.0, -360.0, 360.0) * kDeg;

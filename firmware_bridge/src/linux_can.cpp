@@ -1,6 +1,7 @@
 #include "semap/firmware_bridge/linux_can.hpp"
 
 #include <linux/can.h>
+#include <linux/can/error.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -33,6 +34,18 @@ bool write_can_frame(int fd, const SemapCanFrame& frame) {
     return false;
   }
   return false;
+}
+
+bool write_can_error_frame(int fd, std::uint32_t error_class, std::uint8_t controller) {
+  can_frame kernel{};
+  kernel.can_id = CAN_ERR_FLAG | (error_class & CAN_ERR_MASK);
+  kernel.len = CAN_ERR_DLC;
+  kernel.data[1] = controller;
+  ssize_t n = 0;
+  do {
+    n = ::write(fd, &kernel, sizeof(kernel));
+  } while (n < 0 && errno == EINTR);
+  return n == static_cast<ssize_t>(sizeof(kernel));
 }
 
 bool from_kernel_frame(const void* bytes, std::size_t size, SemapCanFrame& out) {

@@ -167,7 +167,7 @@ void MapPager::after_insert(const InsertResult& result) {
   }
 }
 
-void MapPager::update(const Eigen::Vector3f& robot) {
+std::vector<common::BlockIndex> MapPager::update(const Eigen::Vector3f& robot) {
   const common::MapGrid grid = map_.params().grid();
   const float side = grid.block_size();
   const auto distance = [&](const common::BlockIndex& index) {
@@ -178,6 +178,7 @@ void MapPager::update(const Eigen::Vector3f& robot) {
     if (distance(index) > radius_ + side) far.push_back(index);
   });
   const auto scans = static_cast<std::uint64_t>(map_.scans());
+  std::vector<common::BlockIndex> evicted;
   for (const common::BlockIndex& index : far) {
     const Block& block = *map_.find_block(index);
     try {
@@ -193,6 +194,7 @@ void MapPager::update(const Eigen::Vector3f& robot) {
     stats_.failing = false;
     map_.evict(index);
     out_.insert(index);
+    evicted.push_back(index);
     ++stats_.evicted;
   }
   std::vector<common::BlockIndex> near;
@@ -204,6 +206,7 @@ void MapPager::update(const Eigen::Vector3f& robot) {
     out_.erase(index);
     ++stats_.restored;
   }
+  return evicted;
 }
 
 }  // namespace semap::mapping

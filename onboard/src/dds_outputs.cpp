@@ -66,21 +66,25 @@ void DdsOutputs::stop() {
   update_counters();
 }
 
-void DdsOutputs::blocks_changed(const std::vector<common::BlockIndex>& blocks) {
+void DdsOutputs::blocks_changed(const std::vector<common::BlockIndex>& updated,
+                                const std::vector<common::BlockIndex>& paged_out) {
   std::lock_guard lock(changed_mutex_);
-  changed_.insert(blocks.begin(), blocks.end());
+  changed_.insert(updated.begin(), updated.end());
+  paged_out_.insert(paged_out.begin(), paged_out.end());
 }
 
 void DdsOutputs::take_changed() {
-  std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed, paged_out;
   {
     std::lock_guard lock(changed_mutex_);
     changed.swap(changed_);
+    paged_out.swap(paged_out_);
   }
   for (const auto& index : changed) {
     map_publisher_.changed(index);
     if (costmap_) costmap_->changed(index);
   }
+  for (const auto& index : paged_out) map_publisher_.forget(index);
 }
 
 void DdsOutputs::update_counters() {

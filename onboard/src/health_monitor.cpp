@@ -42,7 +42,8 @@ dds_idl::DriverCountersData driver_health(const std::string& name, const drivers
           s.bus_restarts,
           s.wakeup.p50_ms,
           s.wakeup.p99_ms,
-          s.wakeup.max_ms};
+          s.wakeup.max_ms,
+          static_cast<float>(s.longest_gap_s)};
 }
 
 }  // namespace semap::onboard

@@ -139,15 +139,17 @@ void MappingStage::run(std::stop_token stop) {
   tbb::task_arena arena(config_.threads);
   if (config_.resume && sink_) {
     // Subscribers get the resumed map before anything new.
+    // With a pager, they are all in the log: published once, then paged out of DDS too.
     std::vector<common::BlockIndex> resumed;
     if (pager_) {
       resumed = checkpoint_->log().blocks();
+      sink_(resumed, resumed);
     } else {
       map_.for_each_block([&](const common::BlockIndex& index, const mapping::Block&) {
         resumed.push_back(index);
       });
+      sink_(resumed, {});
     }
-    sink_(resumed);
   }
   common::LabeledCloud cloud;
   int idle = 0;
@@ -171,9 +173,10 @@ void MappingStage::run(std::stop_token stop) {
 void MappingStage::insert(const common::LabeledCloud& cloud) {
   const auto t0 = std::chrono::steady_clock::now();
   mapping::InsertResult result;
+  std::vector<common::BlockIndex> paged_out;
   {
     std::unique_lock lock(map_mutex_);
-    if (pager_) pager_->update(cloud.origin);
+    if (pager_) paged_out = pager_->update(cloud.origin);
     result = map_.insert(cloud, cloud.origin);
     if (pager_) pager_->after_insert(result);
     for (const auto& index : result.updated_blocks) ++versions_[index];
@@ -190,7 +193,7 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   stage_.figures().insert_seconds_max = std::max(stage_.figures().insert_seconds_max, seconds);
   stage_.figures().map = map_.stats();
   note_writes();
-  if (sink_) sink_(result.updated_blocks);
+  if (sink_) sink_(result.updated_blocks, paged_out);
   stage_.share();
 }
 

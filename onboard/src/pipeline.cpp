@@ -88,8 +88,9 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
   }
   mapping_ = std::make_unique<MappingStage>(
       config_.map, cloud_ring_,
-      [this](const std::vector<common::BlockIndex>& changed) {
-        if (dds_) dds_->blocks_changed(changed);
+      [this](const std::vector<common::BlockIndex>& changed,
+             const std::vector<common::BlockIndex>& paged_out) {
+        if (dds_) dds_->blocks_changed(changed, paged_out);
         for (PipelineObserver* o : observers_) o->on_mapped(changed);
       },
       checkpoint_path_);

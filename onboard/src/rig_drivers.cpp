@@ -74,21 +74,24 @@ void RigDrivers::summary(std::vector<std::string>& lines) const {
   if (gnss_) {
     const auto g = gnss_->stats();
     lines.push_back(
-        fmt::format("gnss driver      : {} fixes, {} bytes, {} checksum failures, {} reconnects",
-                    g.frames, g.bytes, g.checksum_failures, g.reconnects));
+        fmt::format("gnss driver      : {} fixes, {} bytes, {} checksum failures, {} reconnects, "
+                    "longest gap {:.2f} s",
+                    g.frames, g.bytes, g.checksum_failures, g.reconnects, g.longest_gap_s));
   }
   if (imu_) {
     const auto i = imu_->stats();
     lines.push_back(fmt::format(
         "imu driver       : {} samples, {} CRC failures, {} gaps, {} reconnects, {} bus-off "
-        "({} restarts), {} error-passive{}",
+        "({} restarts), {} error-passive, longest gap {:.2f} s{}",
         i.frames, i.checksum_failures, i.sequence_gaps, i.reconnects, i.bus_off, i.bus_restarts,
-        i.error_passive, wakeup_text(i.wakeup)));
+        i.error_passive, i.longest_gap_s, wakeup_text(i.wakeup)));
   }
   if (camera_) {
     const auto c = camera_->stats();
-    lines.push_back(fmt::format("camera driver    : {} frames, {} bad, {} reconnects{}", c.frames,
-                                c.checksum_failures, c.reconnects, wakeup_text(c.wakeup)));
+    lines.push_back(fmt::format(
+        "camera driver    : {} frames, {} bad, {} reconnects, longest gap "
+        "{:.2f} s{}",
+        c.frames, c.checksum_failures, c.reconnects, c.longest_gap_s, wakeup_text(c.wakeup)));
   }
 }
 

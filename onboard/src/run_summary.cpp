@@ -66,11 +66,12 @@ void mapping_summary(const MappingStageStats& map, const std::filesystem::path& 
 
 void dds_summary(const DdsOutputs& dds, std::vector<std::string>& lines) {
   const auto m = dds.map_counters();
-  lines.push_back(
-      fmt::format("dds              : {} odometry samples, {} block samples in {} rounds, "
-                  "{} map clouds, {} cloud updates ({} points), {} health reports",
-                  dds.odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
-                  m.cloud_updates_written, m.cloud_update_points, dds.health_written()));
+  lines.push_back(fmt::format(
+      "dds              : {} odometry samples, {} block samples in {} rounds, "
+      "{} map clouds, {} cloud updates ({} points), {} health reports, {} paged-out "
+      "blocks out of the writer's history",
+      dds.odometry_written(), m.blocks_written, m.block_publications, m.clouds_written,
+      m.cloud_updates_written, m.cloud_update_points, dds.health_written(), m.blocks_forgotten));
   if (const auto c = dds.costmap_counters()) {
     lines.push_back(fmt::format(
         "costmap          : {} grids ({} rebuilt around the robot), {} updates, last round "

@@ -1,5 +1,6 @@
 #include "semap/sim/drive_simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -38,13 +39,14 @@ class Profile {
 
   double speed(double t) const {
     const double tm = t - c_.static_s;
-    const double r = ramp(tm, 8.0);
-    if (c_.scenario == Scenario::kFigureEight) return c_.speed_m_s * r;
+    const double r = ramp(tm, kRampS);
+    if (c_.scenario != Scenario::kCar) return c_.speed_m_s * r;
     return c_.speed_m_s * r * (1.0 + 0.3 * std::sin(kTwoPi * tm / 45.0));
   }
   double yaw_rate(double t) const {
     const double tm = t - c_.static_s;
-    const double r = ramp(tm, 8.0);
+    const double r = ramp(tm, kRampS);
+    if (c_.scenario == Scenario::kLoops) return speed(t) * loop_curvature(distance(t));
     if (c_.scenario == Scenario::kFigureEight) {
       // Alternating loops of radius ~ speed / omega.
       const double omega = c_.speed_m_s / 25.0;
@@ -55,8 +57,8 @@ class Profile {
   }
   double climb(double t) const {
     const double tm = t - c_.static_s;
-    if (c_.scenario == Scenario::kFigureEight) return 0.0;
-    return ramp(tm, 8.0) * 0.3 * std::sin(kTwoPi * tm / 25.0);
+    if (c_.scenario != Scenario::kCar) return 0.0;
+    return ramp(tm, kRampS) * 0.3 * std::sin(kTwoPi * tm / 25.0);
   }
   double pitch(double t) const {
     const double s = speed(t);
@@ -64,6 +66,31 @@ class Profile {
   }
 
  private:
+  static constexpr double kRampS = 8.0;  // from rest to full speed
+
+  // Distance driven by time t: the integral of speed(), in closed form (ramp is a smoothstep).
+  double distance(double t) const {
+    const double tm = t - c_.static_s;
+    if (tm <= 0.0) return 0.0;
+    if (tm >= kRampS) return c_.speed_m_s * (tm - kRampS / 2.0);
+    const double x = tm / kRampS;
+    return c_.speed_m_s * kRampS * (x * x * x - x * x * x * x / 2.0);
+  }
+
+  // kLoops: curvature +1/R on even laps, -1/R on odd ones; each switch is blended over a few
+  // metres by tanh, which is odd about the switch, so every lap still turns exactly 2 pi and
+  // the drive repeats every two laps.
+  double loop_curvature(double s) const {
+    constexpr double kBlendM = 0.5;
+    const double radius = c_.loop_radius_m;
+    const double lap = kTwoPi * radius;
+    const double k = std::floor(s / lap);
+    const double sign = std::fmod(k, 2.0) == 0.0 ? 1.0 : -1.0;
+    double to_switch = (k + 1.0) * lap - s;
+    if (k > 0.0) to_switch = std::min(to_switch, s - k * lap);
+    return sign * std::tanh(to_switch / kBlendM) / radius;
+  }
+
   SimulatorConfig c_;
 };
 
@@ -130,8 +157,9 @@ Motion motion_at(const Profile& p, const Kinematics& k, double t, const Vector3d
 }  // namespace
 
 DriveData simulate(const SimulatorConfig& c) {
-  if (!(c.imu_rate_hz > 0.0) || !(c.gnss_rate_hz > 0.0) || !(c.duration_s > 0.0)) {
-    throw std::invalid_argument("simulate: rates and duration must be positive");
+  if (!(c.imu_rate_hz > 0.0) || !(c.gnss_rate_hz > 0.0) || !(c.duration_s > 0.0) ||
+      !(c.loop_radius_m > 0.0)) {
+    throw std::invalid_argument("simulate: rates, duration and loop radius must be positive");
   }
   DriveData out;
   out.origin = c.origin;

@@ -1,5 +1,6 @@
 #include "semap/sim/emulator.hpp"
 
+#include <linux/can/error.h>
 #include <poll.h>
 #include <time.h>
 #include <unistd.h>
@@ -94,6 +95,24 @@ void Emulator::emit_imu(const common::ImuSample& sample) {
     ++sequence_;  // the sensor keeps sampling while its connector is loose
     ++stats_.injected.silenced_imu_samples;
     return;
+  }
+  if (config_.can_fd >= 0 && within(sample.stamp, f.can_bus_off_at_s, f.can_bus_off_s)) {
+    if (!bus_off_) {
+      bus_off_ = true;
+      ++stats_.injected.bus_off_entries;
+      if (!firmware_bridge::write_can_error_frame(config_.can_fd, CAN_ERR_BUSOFF)) {
+        ++stats_.can_write_failures;
+      }
+    }
+    ++sequence_;
+    ++stats_.injected.bus_off_imu_samples;
+    return;
+  }
+  if (bus_off_) {
+    bus_off_ = false;
+    if (!firmware_bridge::write_can_error_frame(config_.can_fd, CAN_ERR_RESTARTED)) {
+      ++stats_.can_write_failures;
+    }
   }
   // One fault at most per sample; never in the first sample so the receiver has a reference.
   CanFault fault = CanFault::kNone;

@@ -154,6 +154,11 @@ void SimRig::summary(std::vector<std::string>& lines) const {
         "{} epochs offset",
         faults_.gnss_jump_m, faults_.gnss_jump_at_s, faults_.gnss_jump_s, injected.gnss_jumps));
   }
+  if (faults_.can_bus_off_s > 0.0) {
+    lines.push_back(fmt::format(
+        "fault injected   : CAN bus-off from {:.1f} s for {:.1f} s, {} IMU samples not sent",
+        faults_.can_bus_off_at_s, faults_.can_bus_off_s, injected.bus_off_imu_samples));
+  }
 }
 
 std::optional<estimation::TruthSample> SimRig::truth_at(common::Stamp stamp) const {

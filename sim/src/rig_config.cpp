@@ -8,9 +8,11 @@ namespace {
 
 void read_keys(const ConfigSection& s, SimRigConfig& rig) {
   auto& t = rig.trajectory;
-  t.scenario = s.get_choice("scenario", "figure8", {"car", "figure8"}) == "car"
-                   ? Scenario::kCar
-                   : Scenario::kFigureEight;
+  const std::string scenario = s.get_choice("scenario", "figure8", {"car", "figure8", "loops"});
+  t.scenario = scenario == "car"       ? Scenario::kCar
+               : scenario == "figure8" ? Scenario::kFigureEight
+                                       : Scenario::kLoops;
+  t.loop_radius_m = s.get_in_range("loop_radius_m", t.loop_radius_m, 10.0, 1000.0);
   t.speed_m_s = s.get_in_range("speed_m_s", 5.0, 0.5, 40.0);
   t.imu_rate_hz = s.get_in_range("imu_rate_hz", 200.0, 50.0, 1000.0);
   t.gnss_rate_hz = s.get_in_range("gnss_rate_hz", 10.0, 1.0, 20.0);
@@ -38,6 +40,7 @@ void read_faults(const ConfigSection& rig, FaultConfig& f) {
   };
   window("gnss_silent", f.gnss_silent_at_s, f.gnss_silent_s);
   window("gnss_jump", f.gnss_jump_at_s, f.gnss_jump_s);
+  window("can_bus_off", f.can_bus_off_at_s, f.can_bus_off_s);
   f.gnss_jump_m = s.get_in_range("gnss_jump_m", f.gnss_jump_m, -1e4, 1e4);
   if (s.has("gnss_jump_m") && f.gnss_jump_s <= 0.0) {
     s.reject("gnss_jump_m", "needs gnss_jump_s > 0 (the window the offset applies in)");
@@ -53,6 +56,10 @@ onboard::RigKeys sim_rig_keys(SimRigConfig& out) {
     read_faults(rig, out.faults);
     if (rig.has("faults") && c.rig.kind != onboard::RigKind::kSim) {
       rig.reject("faults", "only the simulated rig injects faults");
+    }
+    if (out.faults.can_bus_off_s > 0.0 && c.imu.interface.empty()) {
+      rig.section_or_empty("faults").reject("can_bus_off_at_s",
+                                            "needs imu.interface: a CAN bus to go bus-off");
     }
     if (c.rig.kind == onboard::RigKind::kSim && c.depth.source != onboard::DepthSource::kAligned) {
       root.section_or_empty("depth").reject("source",

@@ -204,5 +204,41 @@ TEST_F(DdsTest, PublisherSendsOnlyChangedBlocksAtItsRate) {
   EXPECT_THROW(pub.publish_changed(Stamp::now()), std::invalid_argument);
 }
 
+// Paged-out blocks leave the writer's history: a reader that has them keeps them, a late joiner
+// gets only the blocks still held, and a forgotten block that changes again goes out again.
+TEST_F(DdsTest, ForgottenBlocksStayWithReadersButNotInTheWritersHistory) {
+  const std::string ns = unique_ns("forget");
+  Participant participant(test_domain());
+  MapPublisherConfig cfg;
+  cfg.ns = ns;
+  cfg.cloud_hz = 0.0;
+  SnapshotStore pub_blocks;
+  MapPublisher pub(participant, cfg, test_description(3), pub_blocks);
+  MapClient early(participant, {ns, {}});
+  for (int i = 0; i < 30; ++i) pub.changed(pub_blocks.put(make_block(grid_index(i), 1, 3, false)));
+  // Forgotten in the same round it first goes out: written, then taken out of the history.
+  pub.forget(grid_index(0));
+  EXPECT_EQ(pub.publish_changed(Stamp::now()), 30u);
+  for (int i = 1; i < 10; ++i) pub.forget(grid_index(i));
+  pub.publish_changed(Stamp::now());
+  EXPECT_EQ(pub.counters().blocks_forgotten, 10u);
+  ASSERT_TRUE(early.wait_for_blocks(30, seconds(10)));
+  std::this_thread::sleep_for(milliseconds(300));  // the unregistrations arrive too
+  early.poll();
+  EXPECT_EQ(early.blocks().size(), 30u) << "a reader keeps what it received";
+
+  MapClient late(participant, {ns, {}});
+  ASSERT_TRUE(late.wait_for_blocks(20, seconds(10)));
+  std::this_thread::sleep_for(milliseconds(500));
+  late.poll();
+  EXPECT_EQ(late.blocks().size(), 20u) << "a late joiner gets only the blocks still held";
+  EXPECT_FALSE(late.blocks().contains(grid_index(3)));
+
+  pub.changed(pub_blocks.put(make_block(grid_index(3), 2, 3, false)));
+  EXPECT_EQ(pub.publish_changed(Stamp::now()), 1u);
+  ASSERT_TRUE(late.wait_for_blocks(21, seconds(10)));
+  EXPECT_EQ(late.blocks().at(grid_index(3)).version, 2u);
+}
+
 }  // namespace
 }  // namespace semap::dds_idl::testing

@@ -135,7 +135,10 @@ TEST_F(DdsTest, Ros2NodeJoiningLateGetsTheWholeMapAndFollowsIt) {
   onboard::DdsOutputs* outputs_of_stage = nullptr;
   onboard::MappingStage stage(
       mapping, clouds,
-      [&](const std::vector<common::BlockIndex>& b) { outputs_of_stage->blocks_changed(b); }, {});
+      [&](const std::vector<common::BlockIndex>& b, const std::vector<common::BlockIndex>&) {
+        outputs_of_stage->blocks_changed(b);
+      },
+      {});
   Eigen::Isometry3d camera = Eigen::Isometry3d::Identity();
   camera.translation() = Eigen::Vector3d(0.2, 0.0, 1.1);
   onboard::DdsOutputs outputs(dds, onboard::describe_map(mapping), stage.blocks(),

@@ -15,15 +15,19 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "hil_env.hpp"
+#include "onboard_process.hpp"
 #include "semap/drivers/driver_error.hpp"
 #include "semap/drivers/v4l2_device.hpp"
 #include "support/onnx_writer.hpp"
@@ -34,9 +38,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
+using hil::Child;
 using hil::find_program;
 using hil::find_vivid;
+using hil::parse_summary;
 using hil::read_file;
+using hil::Summary;
+using hil::write_file;
 
 constexpr double kRunSeconds = 20.0;       // semap-onboard --duration
 constexpr double kPipelineSeconds = 30.0;  // the simulated rig's drive
@@ -64,69 +72,6 @@ std::string find_vivid_output(const std::string& capture) {
   }
   return "";
 }
-
-fs::path write_file(const fs::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-  return path;
-}
-
-// A child process with stdout and stderr in one file.
-class Child {
- public:
-  Child(const std::vector<std::string>& argv, const fs::path& output) : output_(output) {
-    const int fd = ::open(output.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) throw std::runtime_error("cannot create " + output.string());
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(fd, STDOUT_FILENO);
-      ::dup2(fd, STDERR_FILENO);
-      ::execv(args[0], args.data());
-      std::perror(args[0]);
-      ::_exit(127);
-    }
-    ::close(fd);
-    if (pid_ < 0) throw std::runtime_error("fork failed");
-  }
-  ~Child() {
-    if (running()) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  bool running() { return pid_ > 0 && !poll(); }
-  // The exit code (128 + signal when killed), or nothing while it still runs after `timeout`.
-  std::optional<int> wait(std::chrono::milliseconds timeout) {
-    hil::wait_until([&] { return poll().has_value(); }, timeout);
-    return status_;
-  }
-  // SIGTERM, then SIGKILL if it does not exit within `grace`.
-  int stop(std::chrono::milliseconds grace) {
-    if (running()) ::kill(pid_, SIGTERM);
-    if (auto code = wait(grace)) return *code;
-    ::kill(pid_, SIGKILL);
-    return wait(5s).value_or(-1);
-  }
-  std::string output() const { return read_file(output_); }
-
- private:
-  const std::optional<int>& poll() {
-    int status = 0;
-    if (!status_ && ::waitpid(pid_, &status, WNOHANG) == pid_) {
-      status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    }
-    return status_;
-  }
-
-  fs::path output_;
-  pid_t pid_ = -1;
-  std::optional<int> status_;
-};
 
 // Sets a menu control of the device by its name and the name of the item; returns the control's
 // id and the value it had, to restore it.
@@ -229,52 +174,6 @@ std::pair<std::uint32_t, std::uint32_t> smallest_yuyv_size(int fd) {
     if (w >= 320 && w % 4 == 0 && w * h < best.first * best.second) best = {w, h};
   }
   return best;
-}
-
-// The figures the test checks, from semap-onboard's summary.
-struct Summary {
-  bool initialised = false;
-  unsigned long imu_samples = 0, gnss_fixes = 0;
-  unsigned long camera_frames = 0, camera_bad = 0;
-  unsigned long perception_frames = 0, clouds = 0, cloud_points = 0, perception_bad = 0;
-  unsigned long scans = 0, blocks = 0;
-  std::optional<double> pose_rmse;  // only on the simulated rig
-  std::string missing;              // summary lines not found
-};
-
-Summary parse_summary(const std::string& out) {
-  Summary s;
-  std::smatch m;
-  const auto find = [&](const char* name, const std::regex& re) {
-    if (std::regex_search(out, m, re)) return true;
-    s.missing += std::string(name) + " ";
-    return false;
-  };
-  if (find("estimation",
-           std::regex(R"(estimation +: (\d+) IMU samples, (\d+) GNSS fixes.*initialised=(\w+))"))) {
-    s.imu_samples = std::stoul(m[1]);
-    s.gnss_fixes = std::stoul(m[2]);
-    s.initialised = m[3] == "yes";
-  }
-  if (find("camera driver", std::regex(R"(camera driver +: (\d+) frames, (\d+) bad)"))) {
-    s.camera_frames = std::stoul(m[1]);
-    s.camera_bad = std::stoul(m[2]);
-  }
-  if (find("perception", std::regex(R"(perception +: (\d+) frames, (\d+) clouds mapped \((\d+) )"
-                                    R"(points\), \d+ passed over, \d+ unpaired, (\d+) bad)"))) {
-    s.perception_frames = std::stoul(m[1]);
-    s.clouds = std::stoul(m[2]);
-    s.cloud_points = std::stoul(m[3]);
-    s.perception_bad = std::stoul(m[4]);
-  }
-  if (find("mapping", std::regex(R"(mapping +: (\d+) scans, .*, (\d+) blocks,)"))) {
-    s.scans = std::stoul(m[1]);
-    s.blocks = std::stoul(m[2]);
-  }
-  if (std::regex_search(out, m, std::regex(R"(pose vs truth +: position RMSE ([0-9.]+) m)"))) {
-    s.pose_rmse = std::stod(m[1]);
-  }
-  return s;
 }
 
 class OnboardHil : public ::testing::Test {
@@ -506,22 +405,33 @@ std::string onboard_config(const fs::path& dir, const std::string& camera, std::
   return c.str();
 }
 
-TEST_F(OnboardHil, MapsFromVividStereoWithImuOnVcanAndGnssOnPty) {
-  ASSERT_NO_FATAL_FAILURE(set_vivid_pattern());
-  const auto [width, height] = smallest_yuyv_size(fd_);
+struct HardwareRun {
+  std::optional<int> code;  // semap-onboard's exit status
+  int sim_code = -1;        // semap-sensor-sim's
+  std::string out;          // semap-onboard's output
+};
+
+// semap-onboard on the hardware configuration: semap-sensor-sim's IMU on vcan0 and GNSS on a
+// pty, vivid (showing checkers) as a side-by-side stereo camera, the 1x1 ONNX segmenter.
+// `during` runs while the robot drives (a fault to inject).
+HardwareRun run_on_vivid_stereo(const std::string& onboard_program, const std::string& sensor_sim,
+                                const std::string& camera, int fd, const fs::path& dir,
+                                const std::function<void(Child&)>& during) {
+  HardwareRun run;
+  const auto [width, height] = smallest_yuyv_size(fd);
   const std::uint32_t half = width / 2;
-  std::printf("camera %s: YUYV %ux%u, two %ux%u halves\n", camera_.c_str(), width, height, half,
+  std::printf("camera %s: YUYV %ux%u, two %ux%u halves\n", camera.c_str(), width, height, half,
               height);
-  write_file(dir_ / "stereo.yaml", stereo_calibration(half, height, 8.0));
-  write_segmenter(dir_, half, height);
+  write_file(dir / "stereo.yaml", stereo_calibration(half, height, 8.0));
+  write_segmenter(dir, half, height);
   // A slow circle: 1 m/s, 0.05 rad/s; IMU at 200 Hz, GNSS at 5 Hz.
-  write_file(dir_ / "trajectory.yaml",
+  write_file(dir / "trajectory.yaml",
              "trajectory:\n  speed_mps: 1.0\n  yaw_rate_rad_s: 0.05\n  imu_rate_hz: 200\n"
              "  gnss_rate_hz: 5\n  gnss_sigma_m: 0.3\n");
 
-  Child sim({sensor_sim_, "--can-if", "vcan0", "--pty", "--config",
-             (dir_ / "trajectory.yaml").string(), "--duration", std::to_string(kRunSeconds + 120)},
-            dir_ / "sensor-sim.log");
+  Child sim({sensor_sim, "--can-if", "vcan0", "--pty", "--config",
+             (dir / "trajectory.yaml").string(), "--duration", std::to_string(kRunSeconds + 120)},
+            dir / "sensor-sim.log");
   std::smatch m;
   std::string sim_out;
   const bool pty = hil::wait_until(
@@ -530,26 +440,35 @@ TEST_F(OnboardHil, MapsFromVividStereoWithImuOnVcanAndGnssOnPty) {
         return std::regex_search(sim_out, m, std::regex(R"(pty (/dev/pts/\d+))")) || !sim.running();
       },
       20s);
-  ASSERT_TRUE(pty && m.size() == 2) << "semap-sensor-sim printed no pty:\n" << sim_out;
+  EXPECT_TRUE(pty && m.size() == 2) << "semap-sensor-sim printed no pty:\n" << sim_out;
+  if (!pty || m.size() != 2) return run;
   const std::string gnss_device = m[1];
   std::printf("semap-sensor-sim: IMU on vcan0, GNSS on %s\n", gnss_device.c_str());
 
-  write_file(dir_ / "onboard.yaml", onboard_config(dir_, camera_, width, height, gnss_device));
+  write_file(dir / "onboard.yaml", onboard_config(dir, camera, width, height, gnss_device));
 
   const auto started = std::chrono::steady_clock::now();
-  Child onboard({onboard_, "--config", (dir_ / "onboard.yaml").string(), "--duration",
+  Child onboard({onboard_program, "--config", (dir / "onboard.yaml").string(), "--duration",
                  std::to_string(kRunSeconds)},
-                dir_ / "onboard.log");
-  const auto code =
-      onboard.wait(std::chrono::milliseconds(static_cast<int>(1e3 * kRunSeconds)) + 120s);
+                dir / "onboard.log");
+  if (during) during(onboard);
+  run.code = onboard.wait(std::chrono::milliseconds(static_cast<int>(1e3 * kRunSeconds)) + 120s);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  const int sim_code = sim.stop(10s);
-  const std::string out = onboard.output();
+  run.sim_code = sim.stop(10s);
+  run.out = onboard.output();
   std::printf("---- semap-onboard (%.1f s) ----\n%s\n---- semap-sensor-sim ----\n%s\n", wall,
-              out.c_str(), sim.output().c_str());
+              run.out.c_str(), sim.output().c_str());
   std::fflush(stdout);
+  return run;
+}
 
+TEST_F(OnboardHil, MapsFromVividStereoWithImuOnVcanAndGnssOnPty) {
+  ASSERT_NO_FATAL_FAILURE(set_vivid_pattern());
+  const HardwareRun run = run_on_vivid_stereo(onboard_, sensor_sim_, camera_, fd_, dir_, nullptr);
+  const auto& code = run.code;
+  const int sim_code = run.sim_code;
+  const std::string& out = run.out;
   ASSERT_TRUE(code.has_value()) << "semap-onboard did not exit";
   EXPECT_EQ(*code, 0);
   EXPECT_EQ(sim_code, 0) << "semap-sensor-sim";
@@ -566,6 +485,65 @@ TEST_F(OnboardHil, MapsFromVividStereoWithImuOnVcanAndGnssOnPty) {
   EXPECT_GT(s.cloud_points, 0u);
   EXPECT_GT(s.scans, 0u);
   EXPECT_GT(s.blocks, 0u);
+}
+
+// Time of day in seconds, as spdlog stamps the robot's log (local time).
+double seconds_of_day(std::chrono::system_clock::time_point t) {
+  const std::time_t tt = std::chrono::system_clock::to_time_t(t);
+  std::tm tm{};
+  ::localtime_r(&tt, &tm);
+  const double fraction =
+      std::chrono::duration<double>(t - std::chrono::system_clock::from_time_t(tt)).count();
+  return tm.tm_hour * 3600.0 + tm.tm_min * 60.0 + tm.tm_sec + fraction;
+}
+
+// The camera is unplugged (vivid's platform device unbound: its /dev/video node goes) 8 s into
+// the drive and comes back 3 s later: the robot keeps estimating, the camera driver reconnects
+// within 2 s of the device's return, and the summary shows the reconnect and the gap.
+TEST_F(OnboardHil, CameraUnpluggedAndBackReconnectsWithinTwoSeconds) {
+  const std::string sysfs = "/sys/bus/platform/drivers/vivid/";
+  if (!fs::exists(sysfs + "unbind")) SEMAP_HIL_UNAVAILABLE("no vivid sysfs unbind");
+  ASSERT_NO_FATAL_FAILURE(set_vivid_pattern());
+  std::chrono::system_clock::time_point back;
+  bool replugged = false;
+  const HardwareRun run =
+      run_on_vivid_stereo(onboard_, sensor_sim_, camera_, fd_, dir_, [&](Child& onboard) {
+        std::this_thread::sleep_for(8s);
+        if (!onboard.running()) return;
+        ::close(fd_);  // our own handle would keep the old device alive
+        fd_ = -1;
+        std::ofstream(sysfs + "unbind") << "vivid.0" << std::flush;
+        std::this_thread::sleep_for(3s);
+        std::ofstream(sysfs + "bind") << "vivid.0" << std::flush;
+        back = std::chrono::system_clock::now();
+        replugged = true;
+      });
+  ASSERT_TRUE(replugged) << "semap-onboard stopped before the fault";
+  ASSERT_TRUE(run.code.has_value()) << "semap-onboard did not exit";
+  EXPECT_EQ(*run.code, 0);
+  const Summary s = parse_summary(run.out);
+  EXPECT_TRUE(s.initialised);
+  EXPECT_GT(s.imu_samples, 0u);
+  EXPECT_GT(s.camera_frames, 0u);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      run.out, m,
+      std::regex(
+          R"(camera driver +: \d+ frames, \d+ bad, (\d+) reconnects, longest gap ([0-9.]+) s)")))
+      << "no camera driver line";
+  EXPECT_EQ(std::stoul(m[1]), 1u);
+  const double gap = std::stod(m[2]);
+  EXPECT_GE(gap, 2.8) << "the summary shows the gap";
+  ASSERT_TRUE(std::regex_search(
+      run.out, m,
+      std::regex(R"(\[(\d\d):(\d\d):(\d\d\.\d+)\] \[\w+\] \[info\] reconnected after)")))
+      << "no reconnect in the log";
+  const double reconnected = std::stod(m[1]) * 3600 + std::stod(m[2]) * 60 + std::stod(m[3]);
+  const double after = reconnected - seconds_of_day(back);
+  std::printf("camera back; the driver reconnected %.2f s later; longest camera gap %.2f s\n",
+              after, gap);
+  EXPECT_GE(after, -0.05);
+  EXPECT_LT(after, 2.0);
 }
 
 // semap-onboard on its simulated rig (config/sim.yaml cut down for TCG): IMU as CAN frames on

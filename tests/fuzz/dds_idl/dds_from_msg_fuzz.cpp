@@ -101,6 +101,7 @@ void health(FuzzInput& in) {
     d.wakeup_p50_ms_ = in.take<float>();
     d.wakeup_p99_ms_ = in.take<float>();
     d.wakeup_max_ms_ = in.take<float>();
+    d.longest_gap_s_ = in.take<float>();
   }
   m.stages_._length = m.stages_._maximum = static_cast<std::uint32_t>(stages.size());
   m.stages_._buffer = stages.data();
@@ -115,7 +116,8 @@ void health(FuzzInput& in) {
   for (std::size_t i = 0; i < drivers.size(); ++i) {
     if (r.drivers[i].name != (drivers[i].name_ ? drivers[i].name_ : "")) std::abort();
     if (r.drivers[i].bus_restarts != drivers[i].bus_restarts_) std::abort();
-    if (std::memcmp(&r.drivers[i].wakeup_max_ms, &drivers[i].wakeup_max_ms_, sizeof(float)) != 0) {
+    if (std::memcmp(&r.drivers[i].wakeup_max_ms, &drivers[i].wakeup_max_ms_, sizeof(float)) != 0 ||
+        std::memcmp(&r.drivers[i].longest_gap_s, &drivers[i].longest_gap_s_, sizeof(float)) != 0) {
       std::abort();
     }
   }

@@ -248,6 +248,22 @@ TEST(DriverRealtime, LocksMemoryOrSaysWhyNot) {
   }
 }
 
+// The longest silence between two messages is what an operator looks for after a device went
+// away or a bus went off: it grows only with a longer silence.
+TEST(DriverCountersGap, KeepsTheLongestTimeBetweenTwoMessages) {
+  DriverCounters counters;
+  counters.add_frame();
+  EXPECT_EQ(counters.snapshot().longest_gap_s, 0.0) << "one message has no gap";
+  std::this_thread::sleep_for(200ms);
+  counters.add_frame();
+  const double gap = counters.snapshot().longest_gap_s;
+  EXPECT_GE(gap, 0.19);
+  EXPECT_LT(gap, 5.0);
+  std::this_thread::sleep_for(20ms);
+  counters.add_frame();
+  EXPECT_EQ(counters.snapshot().longest_gap_s, gap) << "a shorter gap changes nothing";
+}
+
 TEST(DriverRealtime, RefusalsNameThePriorityAndTheReason) {
   EXPECT_EQ(set_realtime_priority(100), "SCHED_FIFO priority 100 refused: Invalid argument");
   EXPECT_THROW(SchedulingDriver(100), std::invalid_argument);

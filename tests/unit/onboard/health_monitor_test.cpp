@@ -40,6 +40,7 @@ TEST(HealthMonitor, DriverCountersSumIntegrityAndLosses) {
   s.error_passive = 7;
   s.bus_restarts = 8;
   s.wakeup = {.p50_ms = 0.1f, .p99_ms = 0.4f, .max_ms = 2.5f, .count = 100};
+  s.longest_gap_s = 3.25;
   const auto d = driver_health("imu", s);
   EXPECT_EQ(d.name, "imu");
   EXPECT_EQ(d.frames, 50u);
@@ -52,6 +53,7 @@ TEST(HealthMonitor, DriverCountersSumIntegrityAndLosses) {
   EXPECT_FLOAT_EQ(d.wakeup_p50_ms, 0.1f);
   EXPECT_FLOAT_EQ(d.wakeup_p99_ms, 0.4f);
   EXPECT_FLOAT_EQ(d.wakeup_max_ms, 2.5f);
+  EXPECT_FLOAT_EQ(d.longest_gap_s, 3.25f);
 }
 
 // A full disk reaches the health report: the checkpoint's and the pager's failures on the one

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+
 #include "semap/estimation/left_inekf.hpp"
 #include "semap/estimation/so3.hpp"
 
@@ -30,7 +34,7 @@ SimulatorConfig noiseless(Scenario scenario) {
 // Dead reckoning on noise-free IMU samples must reproduce the truth: the samples and the
 // ground truth come from the same motion.
 TEST(Simulator, ImuIntegratesToTruth) {
-  for (Scenario s : {sim::Scenario::kCar, sim::Scenario::kFigureEight}) {
+  for (Scenario s : {sim::Scenario::kCar, sim::Scenario::kFigureEight, sim::Scenario::kLoops}) {
     const DriveData d = sim::simulate(noiseless(s));
     LeftInekf f(FilterParams{});
     f.reset(d.truth.front().state, Matrix15::Identity());
@@ -48,6 +52,32 @@ TEST(Simulator, ImuIntegratesToTruth) {
       path += (d.truth[i].state.position - d.truth[i - 1].state.position).norm();
     }
     EXPECT_GT(path, 400.0);
+  }
+}
+
+// The loops drive is a figure eight of two circles 4 R across that comes back to the same
+// place, heading and speed every two laps, so a long run covers the same ground again.
+TEST(Simulator, LoopsRepeatEveryTwoLaps) {
+  sim::SimulatorConfig c = noiseless(sim::Scenario::kLoops);
+  c.loop_radius_m = 20.0;
+  c.initial_yaw_rad = 0.0;  // the figure then lies along the axes of the box below
+  const double two_laps_s =
+      50.0;  // a whole number of IMU steps: the pairs compare sample by sample
+  c.speed_m_s = 2.0 * 2.0 * std::numbers::pi * c.loop_radius_m / two_laps_s;
+  c.duration_s = c.static_s + 8.0 + 7.0 * two_laps_s;
+  const DriveData d = sim::simulate(c);
+  const auto steps = static_cast<std::size_t>(std::lround(two_laps_s * c.imu_rate_hz));
+  Eigen::AlignedBox3d box;
+  for (const auto& s : d.truth) box.extend(s.state.position);
+  EXPECT_NEAR(box.sizes().head<2>().maxCoeff(), 4.0 * c.loop_radius_m, 1.0);
+  EXPECT_NEAR(box.sizes().head<2>().minCoeff(), 2.0 * c.loop_radius_m, 1.0);
+  // From the second pair of laps on, every pair retraces the one before it.
+  const std::size_t first = d.truth.size() - 5 * steps;
+  for (std::size_t i = first; i + steps < d.truth.size(); i += steps / 7) {
+    const auto& a = d.truth[i].state;
+    const auto& b = d.truth[i + steps].state;
+    EXPECT_LT((a.position - b.position).norm(), 0.01) << "at " << i;
+    EXPECT_LT(so3_log(a.rotation.transpose() * b.rotation).norm(), 1e-4) << "at " << i;
   }
 }
 

@@ -34,6 +34,7 @@ struct DriverCountersData {
   float wakeup_p50_ms = 0.0f;
   float wakeup_p99_ms = 0.0f;
   float wakeup_max_ms = 0.0f;
+  float longest_gap_s = 0.0f;  // the longest time between two delivered messages
 };
 
 // A file the robot keeps writing (the map checkpoint, a recording): `writes` done, `failures`

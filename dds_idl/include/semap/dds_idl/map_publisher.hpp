@@ -31,6 +31,7 @@ struct MapPublisherCounters {
   // Rounds cut short because a reliable reader did not keep up within the blocking time; the
   // unsent blocks stay pending for the next round.
   std::uint64_t write_timeouts = 0;
+  std::uint64_t blocks_forgotten = 0;  // taken out of the writer's history (forget())
 };
 
 // Where the publisher reads the blocks it sends: the map's own storage, read-only, so the
@@ -80,6 +81,10 @@ class MapPublisher {
 
   // Marks a block changed: it goes out in the next round, read from the source then.
   void changed(const common::BlockIndex& index);
+  // After the next round, takes the block out of the writer's history (a paged-out block): the
+  // subscribers keep it, late joiners do not get it, and the robot's memory does not hold it.
+  // A later change publishes it again.
+  void forget(const common::BlockIndex& index);
   // Writes what is due at `now`; returns the number of blocks written.
   std::size_t spin_once(common::Stamp now);
   // When a round is due at `now`, writes its map_cloud_updates already, so that what the caller
@@ -124,6 +129,8 @@ class MapPublisher {
   BlockSnapshot scratch_;  // the block being written, its buffers reused
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> known_;
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> forgotten_;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> in_history_;  // written, kept
   bool info_dirty_ = true;
   bool updates_due_ = false;  // blocks changed since the last map_cloud_updates
   common::Stamp next_blocks_;

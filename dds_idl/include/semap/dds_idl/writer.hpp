@@ -32,6 +32,13 @@ class Writer {
     if (rc < 0) throw DdsError("dds_write " + topic_name_, rc);
   }
 
+  // Takes the instance whose key fields `key` holds out of the writer's history: readers keep
+  // what they received, late joiners no longer get it. Writing it again registers it again.
+  void unregister(const T& key) {
+    const dds_return_t rc = dds_unregister_instance(entity_.handle(), &key);
+    if (rc < 0) throw DdsError("dds_unregister_instance " + topic_name_, rc);
+  }
+
   // Sends what write_batched queued (Cyclone reports no error here).
   void flush() { dds_write_flush(entity_.handle()); }
 

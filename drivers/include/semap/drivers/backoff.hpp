@@ -6,7 +6,7 @@ namespace semap::drivers {
 
 struct BackoffConfig {
   std::chrono::milliseconds initial{50};
-  std::chrono::milliseconds max{2000};
+  std::chrono::milliseconds max{1000};  // a device that comes back is in use within a second
   double factor = 2.0;
 };
 

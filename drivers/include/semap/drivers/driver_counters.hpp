@@ -1,5 +1,7 @@
 #pragma once
 
+#include <time.h>
+
 #include <atomic>
 #include <cstdint>
 
@@ -20,6 +22,9 @@ struct DriverStats {
   std::uint64_t bus_off = 0;            // CAN: times the controller went bus-off
   std::uint64_t error_passive = 0;      // CAN: times the controller went error-passive
   std::uint64_t bus_restarts = 0;       // CAN: recoveries from bus-off (restarted, back on the bus)
+  // The longest time between two delivered messages so far: a device that went away, a bus
+  // that went off, a sensor that fell silent. 0 before the second message.
+  double longest_gap_s = 0.0;
   // Wake-up lateness of the driver thread: when it handled the data minus the kernel's stamp of
   // the data's arrival (CAN RX, V4L2 buffer), over its last 1024 messages. Empty (count 0) for
   // devices without kernel stamps (serial).
@@ -30,7 +35,18 @@ struct DriverStats {
 // plus a release store is enough and avoids locked instructions in the receive path.
 class DriverCounters {
  public:
-  void add_frame(std::uint64_t n = 1) { bump(frames_, n); }
+  void add_frame(std::uint64_t n = 1) {
+    bump(frames_, n);
+    // The coarse clock (a few ms resolution) costs no syscall; gaps worth reporting are longer.
+    timespec t{};
+    ::clock_gettime(CLOCK_MONOTONIC_COARSE, &t);
+    const std::int64_t now = std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec;
+    if (last_frame_ns_ > 0 &&
+        now - last_frame_ns_ > longest_gap_ns_.load(std::memory_order_relaxed)) {
+      longest_gap_ns_.store(now - last_frame_ns_, std::memory_order_release);
+    }
+    last_frame_ns_ = now;
+  }
   void add_bytes(std::uint64_t n) { bump(bytes_, n); }
   void add_checksum_failure(std::uint64_t n = 1) { bump(checksum_failures_, n); }
   void add_sequence_gap(std::uint64_t n) { bump(sequence_gaps_, n); }
@@ -55,6 +71,7 @@ class DriverCounters {
     s.bus_off = bus_off_.load(std::memory_order_acquire);
     s.error_passive = error_passive_.load(std::memory_order_acquire);
     s.bus_restarts = bus_restarts_.load(std::memory_order_acquire);
+    s.longest_gap_s = 1e-9 * static_cast<double>(longest_gap_ns_.load(std::memory_order_acquire));
     return s;
   }
 
@@ -74,6 +91,8 @@ class DriverCounters {
   std::atomic<std::uint64_t> bus_off_{0};
   std::atomic<std::uint64_t> error_passive_{0};
   std::atomic<std::uint64_t> bus_restarts_{0};
+  std::atomic<std::int64_t> longest_gap_ns_{0};
+  std::int64_t last_frame_ns_ = 0;  // the writer's own
 };
 
 }  // namespace semap::drivers

@@ -31,6 +31,7 @@ struct EstimatorCounters {
   std::uint64_t reanchors_back = 0;
   std::uint64_t position_inflations = 0;  // overconfident or diverged filter recovered
   std::uint64_t init_not_static = 0;      // initialised from a window that was not at rest
+  std::uint64_t imu_gaps_bridged = 0;     // IMU gaps crossed on the last sample and the fixes
 };
 
 // The current filter output.
@@ -75,7 +76,7 @@ class Estimator {
  private:
   struct QueuedImu {
     common::ImuSample sample;
-    bool restart = false;  // first sample after a gap: new time reference only
+    bool restart = false;  // the first sample, or the first after a gap
   };
 
   void process_imu(const QueuedImu& queued);
@@ -84,6 +85,7 @@ class Estimator {
   void apply_gnss(const common::GnssFix& fix);
   void note_rejection(const Eigen::Vector3d& residual);
   void record_pose();
+  void bridge_gap(common::Stamp to);
 
   EstimatorConfig config_;
   double gate2_;
@@ -101,6 +103,7 @@ class Estimator {
   std::optional<common::GnssFix> init_fix_;
   bool initialised_ = false;
   common::Stamp filter_time_;
+  std::optional<common::ImuSample> last_imu_;  // the newest sample integrated
   std::vector<Eigen::Vector3d> rejected_run_;  // residuals of consecutive gated-out fixes
   int consecutive_rejections_ = 0;
 };

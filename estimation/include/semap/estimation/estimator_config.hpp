@@ -61,7 +61,8 @@ struct EstimatorConfig {
   // IMU samples are held this long before integration so that late GNSS fixes still fit
   // in time order; the estimate lags by the same amount.
   double imu_delay_s = 0.0;
-  std::size_t gnss_buffer = 16;
+  // Fixes ahead of the IMU wait here; 64 keeps 6 s of 10 Hz fixes for an IMU gap to use.
+  std::size_t gnss_buffer = 64;
   std::size_t history = 2048;  // poses kept for pose_at()
   // Local frame origin; when absent the first good fix anchors it.
   std::optional<Geodetic> anchor;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "semap/firmware_bridge/can_frame.h"
 
@@ -12,6 +13,11 @@ namespace semap::firmware_bridge {
 // or any datagram socket; retries on EINTR and briefly on ENOBUFS (full TX queue). Returns false
 // when the frame could not be written.
 bool write_can_frame(int fd, const SemapCanFrame& frame);
+
+// Writes a CAN error frame (CAN_ERR_FLAG | error_class, linux/can/error.h) as a controller's
+// driver sends one, e.g. CAN_ERR_BUSOFF or CAN_ERR_RESTARTED; `controller` is data[1]
+// (CAN_ERR_CRTL_*). Returns false when it could not be written.
+bool write_can_error_frame(int fd, std::uint32_t error_class, std::uint8_t controller = 0);
 
 // Converts the bytes of one struct can_frame / canfd_frame (as read from a CAN_RAW socket; the
 // size tells which) to a SemapCanFrame. Returns false for another size or an RTR/error frame.

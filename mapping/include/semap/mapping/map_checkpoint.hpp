@@ -139,7 +139,9 @@ class MapPager {
   // std::invalid_argument unless radius_m > 0.
   MapPager(SemanticMap& map, BlockLog& log, double radius_m);
 
-  void update(const Eigen::Vector3f& robot);
+  // Pages out the blocks beyond the radius and back in those within it; returns the blocks it
+  // paged out.
+  std::vector<common::BlockIndex> update(const Eigen::Vector3f& robot);
   // After each insert (before MapCheckpoint::after_insert): a paged-out block the insert
   // reached (radius too small for the sensor) was started again from zero; its evidence from
   // the log is added back, so nothing is lost.

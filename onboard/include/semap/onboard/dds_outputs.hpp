@@ -47,8 +47,12 @@ class DdsOutputs {
   void stop();
 
   void publish_pose(const PoseOutput& pose);
-  // From the mapping thread: these blocks changed (cheap, never waits for DDS).
-  void blocks_changed(const std::vector<common::BlockIndex>& blocks);
+  // From the mapping thread: these blocks changed, those were paged out to the checkpoint log
+  // (cheap, never waits for DDS). A paged-out block leaves the block writer's history once it
+  // went out: memory stays bounded by map.memory_radius_m, and a late joiner gets the blocks
+  // around the robot rather than the whole map (docs/dds.md).
+  void blocks_changed(const std::vector<common::BlockIndex>& updated,
+                      const std::vector<common::BlockIndex>& paged_out = {});
   // From the main thread, at 1 Hz.
   void publish_health(const dds_idl::HealthReport& report);
 
@@ -84,6 +88,7 @@ class DdsOutputs {
   std::optional<Eigen::Vector2d> robot_;  // from the latest pose
   std::mutex changed_mutex_;
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
+  std::unordered_set<common::BlockIndex, common::BlockIndexHash> paged_out_;
   std::uint64_t health_written_ = 0;  // main thread only
   struct PublisherFigures {
     dds_idl::MapPublisherCounters counters;

@@ -42,15 +42,18 @@ dds_idl::WriterHealthData checkpoint_health(const MappingStageStats& stats,
                                             const std::filesystem::path& path);
 
 // Owns the SemanticMap on its own thread: inserts every posed cloud and tells the block sink
-// (the DDS map publisher) which blocks the insert wrote. The publisher reads them, on its own
-// thread and at its own rate, through blocks(): a read-only view of the map that shares a
-// lock with the inserts, so the map is held once. With a checkpoint path the stage keeps the
-// map recoverable (MapCheckpoint) and, with a memory radius, bounded (MapPager). A checkpoint
-// that cannot be written (disk full) never stops mapping: it is counted, logged and retried.
+// (the DDS map publisher) which blocks the insert wrote and which the pager moved to the log. The
+// publisher reads them, on its own thread and at its own rate, through blocks(): a read-only view
+// of the map that shares a lock with the inserts, so the map is held once. With a checkpoint path
+// the stage keeps the map recoverable (MapCheckpoint) and, with a memory radius, bounded
+// (MapPager). A checkpoint that cannot be written (disk full) never stops mapping: it is counted,
+// logged and retried.
 class MappingStage : private dds_idl::BlockSource, private CostmapSource {
  public:
-  // Called on the mapping thread; must not block.
-  using BlockSink = std::function<void(const std::vector<common::BlockIndex>&)>;
+  // Called on the mapping thread with the blocks an insert wrote and those paged out before
+  // it; must not block.
+  using BlockSink = std::function<void(const std::vector<common::BlockIndex>& updated,
+                                       const std::vector<common::BlockIndex>& paged_out)>;
 
   // Throws mapping::BlockLogError when the checkpoint log cannot be opened or belongs to a map
   // with other parameters (it is never overwritten).

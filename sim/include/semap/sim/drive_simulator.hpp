@@ -11,7 +11,10 @@
 
 namespace semap::sim {
 
-enum class Scenario : std::uint8_t { kCar, kFigureEight };
+// kCar: a meandering, climbing drive that never returns. kFigureEight: alternating turns of
+// radius ~25 m; the loops do not close, so the drive wanders over minutes. kLoops: a figure
+// eight of two circles of loop_radius_m driven in turn, which repeats exactly: for long runs.
+enum class Scenario : std::uint8_t { kCar, kFigureEight, kLoops };
 
 // A GNSS position offset over [start_s, start_s + duration_s) of trajectory time.
 struct GnssJump {
@@ -25,6 +28,7 @@ struct SimulatorConfig {
   double duration_s = 600.0;
   double static_s = 2.0;  // at rest first, for the initialisation window
   double speed_m_s = 10.0;
+  double loop_radius_m = 50.0;  // kLoops only
   double imu_rate_hz = 100.0;
   double gnss_rate_hz = 10.0;
   double gnss_phase_s = 0.003;             // fixes fall between IMU samples, as on real hardware

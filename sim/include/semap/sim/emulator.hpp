@@ -34,6 +34,11 @@ struct FaultConfig {
   // Every epoch's position is offset north by gnss_jump_m (multipath off a wall).
   double gnss_jump_at_s = 0.0;
   double gnss_jump_s = 0.0;
+  // The CAN controller goes bus-off: the error frame its driver sends, then no IMU frame on
+  // the bus (the IMU keeps counting) until the window ends and the "restarted" error frame
+  // (restart-ms) brings it back. Needs a bus (can_fd).
+  double can_bus_off_at_s = 0.0;
+  double can_bus_off_s = 0.0;
   std::uint32_t seed = 1;
 };
 
@@ -49,6 +54,8 @@ struct InjectedFaults {
   std::uint64_t silenced_imu_samples = 0;
   std::uint64_t silenced_gnss_epochs = 0;  // silence_every_s
   std::uint64_t gnss_silent_epochs = 0;    // the scheduled GNSS silence
+  std::uint64_t bus_off_entries = 0;       // CAN_ERR_BUSOFF frames sent
+  std::uint64_t bus_off_imu_samples = 0;   // samples not sent while bus-off
 };
 
 struct EmulatorStats {
@@ -111,6 +118,7 @@ class Emulator {
   EmulatorStats stats_;
   std::mt19937 rng_;
   bool have_first_ = false;
+  bool bus_off_ = false;  // inside the can_bus_off window
   common::Stamp first_stamp_;
   std::uint8_t sequence_ = 0;
 };
