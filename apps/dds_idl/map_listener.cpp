@@ -59,8 +59,8 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--save", save_path, "write the received map as PCD (x y z class variance)");
   app.add_option("--odometry", odometry_path,
-                 "write every odometry sample received as CSV: stamp_s,x,y,z (the header's stamp "
-                 "on this machine's CLOCK_MONOTONIC)");
+                 "write every odometry sample received as CSV: stamp_s,x,y,z,ros_stamp_s (the "
+                 "header's stamp on this machine's CLOCK_MONOTONIC, then as sent, in ROS time)");
   app.add_option("--seconds", seconds, "stop after this long (0: until Ctrl-C)");
   app.add_option("--expect-blocks", expect_blocks, "stop once this many blocks arrived");
   app.add_option("--classes", num_classes, "reject blocks with another class count");
@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
       odometry_csv.open(odometry_path);
       if (!odometry_csv)
         throw std::runtime_error("--odometry " + odometry_path + ": cannot create");
-      odometry_csv << "stamp_s,x,y,z\n";
+      odometry_csv << "stamp_s,x,y,z,ros_stamp_s\n";
     }
     while (!semap::apps::stop_requested()) {
       client.wait_for_blocks(SIZE_MAX, std::chrono::milliseconds(100));
@@ -114,9 +114,12 @@ int main(int argc, char** argv) {
         if (odometry_csv.is_open()) {
           const std::int64_t ns = last_pose->stamp.ns;
           const Eigen::Vector3d& p = last_pose->position;
-          char line[128];
-          std::snprintf(line, sizeof line, "%" PRId64 ".%09" PRId64 ",%.6f,%.6f,%.6f\n",
-                        ns / 1'000'000'000, ns % 1'000'000'000, p.x(), p.y(), p.z());
+          const auto& ros = m.header_.stamp_;
+          char line[160];
+          std::snprintf(line, sizeof line,
+                        "%" PRId64 ".%09" PRId64 ",%.6f,%.6f,%.6f,%" PRId32 ".%09" PRIu32 "\n",
+                        ns / 1'000'000'000, ns % 1'000'000'000, p.x(), p.y(), p.z(), ros.sec_,
+                        ros.nanosec_);
           odometry_csv << line << std::flush;
         }
       });

@@ -202,7 +202,8 @@ TEST_F(OnboardFaults, WallClockStepsAnHourForwardAndBack) {
   int before = 0, ahead = 0, after = 0, outside = 0;
   bool seen_ahead = false;
   while (std::getline(csv, line)) {
-    const double t = std::stod(line.substr(0, line.find(','))) - start;
+    // The last column: the header's stamp as sent (ROS time).
+    const double t = std::stod(line.substr(line.rfind(',') + 1)) - start;
     if (t > 3600.0 - 60.0 && t < 3600.0 + kDriveSeconds + 60.0) {
       ++ahead;
       seen_ahead = true;
