@@ -26,20 +26,6 @@ int realtime_priority(const common::ConfigSection& s) {
   return get_int(s, "realtime_priority", 0, 0, kMaxRealtimePriority);
 }
 
-// `cpus: [1]`: the CPUs the driver's thread may run on (absent: any).
-std::vector<int> cpus(const common::ConfigSection& s) {
-  if (!s.has("cpus")) return {};
-  std::vector<int> list;
-  for (const double v : s.get<std::vector<double>>("cpus")) {
-    if (v != std::floor(v) || v < 0 || v >= 1024) {
-      s.reject("cpus", "CPU numbers are integers 0..1023");
-    }
-    list.push_back(static_cast<int>(v));
-  }
-  if (list.empty()) s.reject("cpus", "name at least one CPU, or leave the key out");
-  return list;
-}
-
 }  // namespace
 
 CanImuConfig can_imu_config(const common::ConfigSection& imu) {
@@ -58,7 +44,7 @@ CanImuConfig can_imu_config(const common::ConfigSection& imu) {
   c.restart_bus_off = imu.get<bool>("restart_bus_off", c.restart_bus_off);
   c.backoff = backoff(imu);
   c.realtime_priority = realtime_priority(imu);
-  c.cpus = cpus(imu);
+  c.cpus = cpu_list(imu, "cpus");
   return c;
 }
 
@@ -79,7 +65,7 @@ GnssConfig gnss_config(const common::ConfigSection& gnss) {
   c.fix.uere_m = gnss.get_in_range("uere_m", c.fix.uere_m, 0.01, 100.0);
   c.backoff = backoff(gnss);
   c.realtime_priority = realtime_priority(gnss);
-  c.cpus = cpus(gnss);
+  c.cpus = cpu_list(gnss, "cpus");
   return c;
 }
 
@@ -97,8 +83,19 @@ CameraConfig camera_config(const common::ConfigSection& camera) {
   c.buffers = static_cast<std::uint32_t>(get_int(camera, "buffers", 4, 2, 32));
   c.backoff = backoff(camera);
   c.realtime_priority = realtime_priority(camera);
-  c.cpus = cpus(camera);
+  c.cpus = cpu_list(camera, "cpus");
   return c;
+}
+
+std::vector<int> cpu_list(const common::ConfigSection& s, const std::string& key) {
+  if (!s.has(key)) return {};
+  std::vector<int> list;
+  for (const double v : s.get<std::vector<double>>(key)) {
+    if (v != std::floor(v) || v < 0 || v >= 1024) s.reject(key, "CPU numbers are integers 0..1023");
+    list.push_back(static_cast<int>(v));
+  }
+  if (list.empty()) s.reject(key, "name at least one CPU, or leave the key out");
+  return list;
 }
 
 }  // namespace semap::drivers

@@ -54,8 +54,9 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
 // Only joins: the map view may be gone by now (stop() is what publishes the last changes).
 DdsOutputs::~DdsOutputs() { publisher_stage_.stop(); }
 
-void DdsOutputs::start() {
-  publisher_stage_.start([this](std::stop_token stop) { run_publisher(stop); });
+void DdsOutputs::start(std::vector<int> cpus) {
+  publisher_stage_.start([this](std::stop_token stop) { run_publisher(stop); }, "dds",
+                         std::move(cpus));
 }
 
 void DdsOutputs::stop() {

@@ -28,8 +28,8 @@ EstimationStage::EstimationStage(const EstimationStageConfig& config,
 
 EstimationStage::~EstimationStage() { stop(); }
 
-void EstimationStage::start() {
-  stage_.start([this](std::stop_token stop) { run(stop); });
+void EstimationStage::start(std::vector<int> cpus) {
+  stage_.start([this](std::stop_token stop) { run(stop); }, "estimation", std::move(cpus));
 }
 
 void EstimationStage::stop() { stage_.stop(); }

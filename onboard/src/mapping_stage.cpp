@@ -108,8 +108,8 @@ void MappingStage::note_writes() {
 
 MappingStage::~MappingStage() { stop(); }
 
-void MappingStage::start() {
-  stage_.start([this](std::stop_token stop) { run(stop); });
+void MappingStage::start(std::vector<int> cpus) {
+  stage_.start([this](std::stop_token stop) { run(stop); }, "mapping", std::move(cpus));
 }
 
 void MappingStage::stop() {

@@ -238,6 +238,15 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
   read_dds(root.section_or_empty("dds"), c.dds);
   const auto realtime = root.section_or_empty("realtime");
   c.realtime.lock_memory = realtime.get<bool>("lock_memory", c.realtime.lock_memory);
+  if (realtime.has("stage_cpus")) {
+    const auto stages = realtime.section("stage_cpus");
+    for (const char* stage : {"estimation", "perception", "mapping", "dds"}) {
+      if (auto cpus = drivers::cpu_list(stages, stage); !cpus.empty()) {
+        c.realtime.stage_cpus[stage] = std::move(cpus);
+      }
+    }
+    stages.finish();
+  }
   realtime.finish();
   if (root.has("costmap")) {
     const auto costmap = root.section("costmap");

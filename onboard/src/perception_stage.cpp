@@ -120,8 +120,8 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
 
 PerceptionStage::~PerceptionStage() { stop(); }
 
-void PerceptionStage::start() {
-  stage_.start([this](std::stop_token stop) { run(stop); });
+void PerceptionStage::start(std::vector<int> cpus) {
+  stage_.start([this](std::stop_token stop) { run(stop); }, "perception", std::move(cpus));
 }
 
 void PerceptionStage::stop() { stage_.stop(); }

@@ -138,10 +138,14 @@ void Pipeline::start() {
     });
   }
   rig_->pace_by([this](const HandedOver& handed) { return has_taken(handed); });
-  estimation_->start();
-  if (perception_) perception_->start();
-  mapping_->start();
-  if (dds_) dds_->start();
+  const auto cpus = [this](const std::string& stage) {
+    const auto it = config_.realtime.stage_cpus.find(stage);
+    return it == config_.realtime.stage_cpus.end() ? std::vector<int>{} : it->second;
+  };
+  estimation_->start(cpus("estimation"));
+  if (perception_) perception_->start(cpus("perception"));
+  mapping_->start(cpus("mapping"));
+  if (dds_) dds_->start(cpus("dds"));
   rig_->start();
   running_ = true;
   started_ = common::Stamp::now();

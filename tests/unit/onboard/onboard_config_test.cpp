@@ -256,6 +256,24 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
 }
 
 // rig.faults: the simulated rig's scheduled GNSS faults, each window with its start and length.
+// Stage threads pinned per stage; a stage left out runs anywhere, a typo is named.
+TEST(OnboardConfig, StageCpus) {
+  const OnboardConfig c = load(edited_sim(
+      "log_level: info", "log_level: info\nrealtime:\n  stage_cpus: {mapping: [1], dds: [0, 1]}"));
+  EXPECT_EQ(c.realtime.stage_cpus.size(), 2u);
+  EXPECT_EQ(c.realtime.stage_cpus.at("mapping"), std::vector<int>{1});
+  EXPECT_EQ(c.realtime.stage_cpus.at("dds"), (std::vector<int>{0, 1}));
+  EXPECT_FALSE(c.realtime.stage_cpus.contains("estimation"));
+  EXPECT_NE(error_of(edited_sim("log_level: info",
+                                "log_level: info\nrealtime:\n  stage_cpus: {maping: [1]}"))
+                .find("realtime.stage_cpus.maping"),
+            std::string::npos);
+  EXPECT_NE(error_of(edited_sim("log_level: info",
+                                "log_level: info\nrealtime:\n  stage_cpus: {mapping: [1.5]}"))
+                .find("CPU numbers are integers"),
+            std::string::npos);
+}
+
 TEST(OnboardConfig, SimulatedRigFaults) {
   sim::SimRigConfig none;
   const auto c = load(kConfigDir / "sim.yaml", &none);

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "semap/common/config.hpp"
 #include "semap/drivers/camera_driver.hpp"
 #include "semap/drivers/can_imu_driver.hpp"
@@ -18,5 +21,8 @@ namespace semap::drivers {
 CanImuConfig can_imu_config(const common::ConfigSection& imu);
 GnssConfig gnss_config(const common::ConfigSection& gnss);
 CameraConfig camera_config(const common::ConfigSection& camera);
+// `key: [1, 2]`: CPU numbers for a thread's affinity (integers 0..1023, at least one); empty
+// when the key is absent.
+std::vector<int> cpu_list(const common::ConfigSection& s, const std::string& key);
 
 }  // namespace semap::drivers

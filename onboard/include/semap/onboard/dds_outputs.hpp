@@ -43,7 +43,8 @@ class DdsOutputs {
   ~DdsOutputs();
 
   // The map publisher's thread; stop() publishes what changed last before it returns.
-  void start();
+  // `cpus`: the CPUs its thread may run on (realtime.stage_cpus; empty: any).
+  void start(std::vector<int> cpus = {});
   void stop();
 
   void publish_pose(const PoseOutput& pose);

@@ -68,7 +68,8 @@ class EstimationStage {
   EstimationStage(const EstimationStage&) = delete;
   EstimationStage& operator=(const EstimationStage&) = delete;
 
-  void start();
+  // `cpus`: the CPUs its thread may run on (realtime.stage_cpus; empty: any).
+  void start(std::vector<int> cpus = {});
   void stop();
   EstimationStageStats stats() const;
   // Age of each IMU sample when the filter has taken it (driver stamp to filter).

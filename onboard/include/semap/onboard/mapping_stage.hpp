@@ -63,7 +63,8 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   MappingStage(const MappingStage&) = delete;
   MappingStage& operator=(const MappingStage&) = delete;
 
-  void start();
+  // `cpus`: the CPUs its thread may run on (realtime.stage_cpus; empty: any).
+  void start(std::vector<int> cpus = {});
   void stop();
   MappingStageStats stats() const;
   // Age of each cloud (its image's capture stamp) once it is in the map.

@@ -4,8 +4,10 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "semap/common/config.hpp"
 #include "semap/dds_idl/converters.hpp"
@@ -104,6 +106,9 @@ struct RealtimeConfig {
   // mlockall at start: no page fault stalls a thread later; a refusal is logged and reported in
   // the summary, and the robot runs on.
   bool lock_memory = false;
+  // `stage_cpus: {estimation: [0], perception: [1], mapping: [1], dds: [0]}`: the CPUs each
+  // stage's thread may run on (a stage left out: any). The drivers' are in their sections.
+  std::map<std::string, std::vector<int>> stage_cpus;
 };
 
 struct OnboardConfig {

@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 #include "semap/common/latency_window.hpp"
 #include "semap/common/messages.hpp"
@@ -75,7 +76,8 @@ class PerceptionStage {
   using FrameTap = std::function<void(const common::ImageFrame&, bool depth)>;
   void set_frame_tap(FrameTap tap) { tap_ = std::move(tap); }
 
-  void start();
+  // `cpus`: the CPUs its thread may run on (realtime.stage_cpus; empty: any).
+  void start(std::vector<int> cpus = {});
   void stop();
   PerceptionStageStats stats() const;
   // Age of each frame (its capture stamp) when its posed cloud goes to the mapping stage.

@@ -3,7 +3,12 @@
 #include <functional>
 #include <mutex>
 #include <stop_token>
+#include <string>
 #include <thread>
+#include <vector>
+
+#include "semap/common/logging.hpp"
+#include "semap/drivers/realtime.hpp"
 
 namespace semap::onboard {
 
@@ -19,8 +24,25 @@ class StageThread {
   StageThread(const StageThread&) = delete;
   StageThread& operator=(const StageThread&) = delete;
 
-  // Runs body(stop token) on the stage's thread.
-  void start(std::function<void(std::stop_token)> body) { thread_ = std::jthread(std::move(body)); }
+  // Runs body(stop token) on the stage's thread, pinned to `cpus` first (empty: anywhere; a
+  // refusal is logged and the thread runs where the kernel places it). TBB workers the body
+  // uses are not pinned.
+  void start(std::function<void(std::stop_token)> body, const std::string& name,
+             std::vector<int> cpus = {}) {
+    thread_ =
+        std::jthread([body = std::move(body), name, cpus = std::move(cpus)](std::stop_token stop) {
+          if (!cpus.empty()) {
+            const std::string refused = drivers::set_cpu_affinity(cpus);
+            if (refused.empty()) {
+              common::logger("onboard")->info("{} stage pinned to {} CPU(s)", name, cpus.size());
+            } else {
+              common::logger("onboard")->warn("{} stage: {}; running where the kernel places it",
+                                              name, refused);
+            }
+          }
+          body(stop);
+        });
+  }
   // Asks the body to return (a stage first empties its input) and waits for it; false when it
   // was not running.
   bool stop() {
