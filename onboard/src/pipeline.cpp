@@ -240,7 +240,7 @@ std::optional<PerceptionStageStats> Pipeline::perception() const {
 }
 
 Rings Pipeline::rings() const {
-  return Rings{imu_ring_, gnss_ring_, colour_ring_, depth_ring_, cloud_ring_};
+  return Rings{imu_ring_, gnss_ring_, colour_ring_, depth_ring_, scan_ring_, cloud_ring_};
 }
 
 std::vector<std::pair<std::string, std::uint64_t>> Pipeline::ring_drops() const {

@@ -29,12 +29,12 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
        {}},
   };
   if (perception) {
-    // Colour frames lost anywhere before the map: in the driver's ring, passed over,
-    // unpaired, unreadable, without a pose or posed too uncertainly.
+    // Colour frames (or a LiDAR rig's scans) lost anywhere before the map: in the driver's
+    // ring, passed over, unpaired, unreadable, without a pose or posed too uncertainly.
     const auto p = perception->stats();
     figures.push_back({"perception", p.clouds, perception->queue_depth(),
-                       drops(r.colour) + p.skipped + p.unpaired + p.bad_frames + p.without_pose +
-                           p.uncertain_pose,
+                       drops(r.colour) + drops(r.scans) + p.skipped + p.unpaired + p.bad_frames +
+                           p.without_pose + p.uncertain_pose,
                        perception->latency().percentiles()});
   }
   return figures;
@@ -55,11 +55,12 @@ std::string Progress::line(double t, const EstimationStageStats& est,
   last_t_ = t;
   return fmt::format(
       "t={:.0f}s init={} | Hz imu {:.0f} gnss {:.1f} frames {:.1f} clouds {:.1f} scans {:.1f} | "
-      "blocks {} | rings imu/gnss/colour/depth/clouds: queued {}/{}/{}/{}/{} dropped "
-      "{}/{}/{}/{}/{}",
+      "blocks {} | rings imu/gnss/colour/depth/scans/clouds: queued {}/{}/{}/{}/{}/{} dropped "
+      "{}/{}/{}/{}/{}/{}",
       t, est.initialised ? "yes" : "no", imu, gnss, frames, clouds, scans, map.map.blocks,
-      r.imu.size(), r.gnss.size(), r.colour.size(), r.depth.size(), r.clouds.size(), drops(r.imu),
-      drops(r.gnss), drops(r.colour), drops(r.depth), drops(r.clouds));
+      r.imu.size(), r.gnss.size(), r.colour.size(), r.depth.size(), r.scans.size(), r.clouds.size(),
+      drops(r.imu), drops(r.gnss), drops(r.colour), drops(r.depth), drops(r.scans),
+      drops(r.clouds));
 }
 
 }  // namespace semap::onboard

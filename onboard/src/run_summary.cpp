@@ -81,9 +81,9 @@ void dds_summary(const DdsOutputs& dds, std::vector<std::string>& lines) {
 }
 
 void ring_summary(const Rings& r, std::vector<std::string>& lines) {
-  lines.push_back(fmt::format("ring drops       : imu {}, gnss {}, colour {}, depth {}, clouds {}",
-                              drops(r.imu), drops(r.gnss), drops(r.colour), drops(r.depth),
-                              drops(r.clouds)));
+  lines.push_back(fmt::format(
+      "ring drops       : imu {}, gnss {}, colour {}, depth {}, scans {}, clouds {}", drops(r.imu),
+      drops(r.gnss), drops(r.colour), drops(r.depth), drops(r.scans), drops(r.clouds)));
 }
 
 }  // namespace semap::onboard

@@ -23,6 +23,7 @@ struct Rings {
   const common::SpscRing<common::GnssFix>& gnss;
   const common::SpscRing<common::ImageFrame>& colour;
   const common::SpscRing<common::ImageFrame>& depth;
+  const common::SpscRing<common::PointScan>& scans;  // a LiDAR rig's
   const common::SpscRing<common::LabeledCloud>& clouds;
 };
 
