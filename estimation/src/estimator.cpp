@@ -119,12 +119,11 @@ void Estimator::process_imu(const QueuedImu& queued) {
     if (last_imu_) {
       bridge_gap(s.stamp);
       ++counters_.imu_gaps_bridged;
-      last_imu_ = s;
       record_pose();
     } else {
       filter_time_ = s.stamp;
-      last_imu_ = s;
     }
+    last_imu_ = s;
     return;
   }
   // The sample holds over (filter_time_, s.stamp]; fixes inside it split the interval.

@@ -178,7 +178,12 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
     std::unique_lock lock(map_mutex_);
     if (pager_) paged_out = pager_->update(cloud.origin);
     result = map_.insert(cloud, cloud.origin);
-    if (pager_) pager_->after_insert(result);
+    if (pager_) {
+      pager_->after_insert(result);
+      // A block the insert reached right after its eviction is back in memory: DDS keeps it.
+      std::erase_if(paged_out,
+                    [&](const common::BlockIndex& i) { return map_.find_block(i) != nullptr; });
+    }
     for (const auto& index : result.updated_blocks) ++versions_[index];
   }
   if (checkpoint_) checkpoint_->after_insert(result);

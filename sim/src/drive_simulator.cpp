@@ -77,8 +77,8 @@ class Profile {
     return c_.speed_m_s * kRampS * (x * x * x - x * x * x * x / 2.0);
   }
 
-  // kLoops: curvature +1/R on even laps, -1/R on odd ones; each switch is blended over a few
-  // metres by tanh, which is odd about the switch, so every lap still turns exactly 2 pi and
+  // kLoops: curvature +1/R on even laps, -1/R on odd ones; each switch is blended over about a
+  // metre by tanh, which is odd about the switch, so every lap still turns exactly 2 pi and
   // the drive repeats every two laps.
   double loop_curvature(double s) const {
     constexpr double kBlendM = 0.5;
