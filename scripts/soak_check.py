@@ -13,7 +13,8 @@ import sys
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--csv", required=True)
-    parser.add_argument("--loop-s", type=float, required=True, help="when the first loop ends")
+    parser.add_argument("--settled-s", type=float, required=True,
+                        help="when the run has settled (the end of its first loops)")
     parser.add_argument("--drive-s", type=float, required=True,
                         help="how long the robot drove: later samples see the final save")
     parser.add_argument("--compare", required=True, help="semap-export --compare output")
@@ -31,22 +32,22 @@ def main():
         if not ok:
             failures.append(text)
 
-    after = [r for r in rows if float(r["t_s"]) >= args.loop_s]
-    check(len(after) >= 3, f"{len(after)} samples after the first loop ({args.loop_s:.0f} s)")
+    after = [r for r in rows if float(r["t_s"]) >= args.settled_s]
+    check(len(after) >= 3, f"{len(after)} samples once settled ({args.settled_s:.0f} s)")
     if not after:
         return 1
     rss_loop = float(after[0]["rss_mib"])
     rss_max = max(float(r["rss_mib"]) for r in after)
     rss_end = float(rows[-1]["rss_mib"])
-    print(f"rss: {rss_loop:.1f} MiB at the end of the first loop, {rss_max:.1f} MiB at most "
+    print(f"rss: {rss_loop:.1f} MiB when settled, {rss_max:.1f} MiB at most "
           f"after it, {rss_end:.1f} MiB at the end ({len(rows)} samples, {rows[-1]['t_s']} s)")
-    check(rss_max <= 1.10 * rss_loop, f"RSS after the first loop within 10 % of {rss_loop:.1f} MiB "
+    check(rss_max <= 1.10 * rss_loop, f"RSS once settled within 10 % of {rss_loop:.1f} MiB "
           f"(max {rss_max:.1f}, {100 * (rss_max / rss_loop - 1):+.1f} %)")
 
     map_mib = os.path.getsize(args.map) / 1048576
     log_max = max(float(r["log_mib"]) for r in after)
     log_end = float(rows[-1]["log_mib"])
-    print(f"checkpoint log: {float(after[0]['log_mib']):.2f} MiB after the first loop, "
+    print(f"checkpoint log: {float(after[0]['log_mib']):.2f} MiB once settled, "
           f"{log_max:.2f} MiB at most, {log_end:.2f} MiB at the end; saved map {map_mib:.2f} MiB")
     # Compaction rewrites the log once it holds three times its live blocks; a checkpoint
     # interval more may be on top.
@@ -56,7 +57,7 @@ def main():
     cpu = [float(r["cpu_percent"]) for r in after if r["cpu_percent"]]
     load = [float(r["load1"]) for r in after]
     drops = int(rows[-1]["health_drops"])
-    print(f"cpu: {sum(cpu) / len(cpu):.0f} % of one core on average after the first loop, "
+    print(f"cpu: {sum(cpu) / len(cpu):.0f} % of one core on average once settled, "
           f"load1 {min(load):.1f}..{max(load):.1f}; drops in health {drops}; checkpoint failures "
           f"{rows[-1]['checkpoint_failures']}")
     for stage in ("perception", "mapping"):

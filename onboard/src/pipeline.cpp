@@ -1,5 +1,6 @@
 #include "semap/onboard/pipeline.hpp"
 
+#include <malloc.h>
 #include <spdlog/fmt/fmt.h>
 
 #include <cmath>
@@ -172,6 +173,9 @@ void Pipeline::tick() {
   }
   if (now >= next_progress_) {
     next_progress_ = now + 5.0;
+    // Paging and checkpoints free blocks on every thread; glibc keeps the freed pages in each
+    // thread's arena, so without this the RSS grows by what the map pages out, not what it holds.
+    malloc_trim(0);
     common::logger("onboard")->info(
         "{}", progress_.line(common::seconds_between(now, started_), est,
                              perception_ ? perception_->stats() : PerceptionStageStats{},
