@@ -321,8 +321,9 @@
           const cost = g.data[row * g.width + col];
           if (cost < 0) continue; // unknown: transparent
           const p = ((g.height - 1 - row) * g.width + col) * 4;
-          const t = Math.min(cost, 100) / 100; // free: dark blue, lethal: red
-          image.data.set([40 + 200 * t, 60 * (1 - t), 110 * (1 - t), 90 + 110 * t], p);
+          const t = Math.min(cost, 100) / 100;
+          if (cost === 0) image.data.set([120, 200, 255, 40], p);
+          else image.data.set([255, 210 * (1 - t), 0, 70 + 110 * t], p);
         }
       }
       ctx.putImageData(image, 0, 0);
@@ -470,6 +471,15 @@
     const s = view.scale;
     const [ox, oy] = toScreen(0, 0);
 
+    mapLayer.raster();
+    if ($('layer-map').checked && mapLayer.origin) {
+      const r = mapLayer.resolution;
+      const [x0, y1] = toScreen(mapLayer.origin[0] * r, (mapLayer.origin[1] + mapLayer.canvas.height) * r);
+      ctx.setTransform(1, 0, 0, 1, 0, 0);
+      ctx.drawImage(mapLayer.canvas, x0, y1, mapLayer.canvas.width * r * s, mapLayer.canvas.height * r * s);
+    }
+
+    // The costmap over the map, translucent: free cells tinted, costs from yellow to red.
     costmapLayer.raster();
     const g = costmapLayer.current;
     if ($('layer-costmap').checked && g) {
@@ -478,14 +488,6 @@
       ctx.rotate(g.yaw);
       ctx.scale(1, -1); // the image's first row is the grid's last
       ctx.drawImage(costmapLayer.canvas, 0, -g.height * g.resolution, g.width * g.resolution, g.height * g.resolution);
-    }
-
-    mapLayer.raster();
-    if ($('layer-map').checked && mapLayer.origin) {
-      const r = mapLayer.resolution;
-      const [x0, y1] = toScreen(mapLayer.origin[0] * r, (mapLayer.origin[1] + mapLayer.canvas.height) * r);
-      ctx.setTransform(1, 0, 0, 1, 0, 0);
-      ctx.drawImage(mapLayer.canvas, x0, y1, mapLayer.canvas.width * r * s, mapLayer.canvas.height * r * s);
     }
 
     ctx.setTransform(1, 0, 0, 1, 0, 0);

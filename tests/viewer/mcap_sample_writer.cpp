@@ -79,7 +79,8 @@ int main(int argc, char** argv) {
       grid.info_.width_ = 100;
       grid.info_.height_ = 80;
       grid.info_.origin_.orientation_.w_ = 1.0;
-      grid.data_ = dds_idl::borrow_sequence<dds_sequence_int8>(cells.data(), cells.size());
+      grid.data_ = dds_idl::borrow_sequence<dds_sequence_octet>(  // int8 cells as octets
+          reinterpret_cast<std::uint8_t*>(cells.data()), cells.size());
       dds_idl::serialize_cdr(grid, cdr);
       writer.write(grid_ch, sequence++, t, t, cdr);
 

@@ -70,15 +70,22 @@ async function main() {
     const state1 = await page.evaluate(() => ({ ...window.semapViewer, health: undefined }));
     const shot1 = path.join(out, 'viewer-1.png');
     await page.screenshot({ path: shot1 });
-    const map1 = await page.locator('#map').screenshot();
-    fs.writeFileSync(path.join(out, 'map-1.png'), map1);
+    // The map canvas alone, the translucent costmap layer switched off for it (it tints cells).
+    const mapShot = async (file) => {
+      await page.uncheck('#layer-costmap');
+      await page.waitForTimeout(200);
+      const png = await page.locator('#map').screenshot();
+      await page.check('#layer-costmap');
+      fs.writeFileSync(path.join(out, file), png);
+      return png;
+    };
+    const map1 = await mapShot('map-1.png');
 
     await page.waitForTimeout(5000);
     const state2 = await page.evaluate(() => ({ ...window.semapViewer, health: undefined }));
     const shot2 = path.join(out, 'viewer-2.png');
     await page.screenshot({ path: shot2 });
-    const map2 = await page.locator('#map').screenshot();
-    fs.writeFileSync(path.join(out, 'map-2.png'), map2);
+    const map2 = await mapShot('map-2.png');
     log('state at the first screenshot: ' + JSON.stringify(state1));
 
     // The map canvas: class colours drawn, on its background.

@@ -94,7 +94,7 @@ case "$mode" in
     res=$(cm resolution) width=$(cm width_m) height=$(cm height_m)
     cells=$(awk -v w="$width" -v h="$height" -v r="$res" 'BEGIN { printf "%dx%d", w / r + 0.5, h / r + 0.5 }')
     status=0
-    node "$here/ws_client_test.js" --url "${url/http:/ws:}" --seconds 30 --stall-at 15 \
+    node "$here/ws_client_test.js" --url "${url/http:/ws:}" --baseline 6 --stall 10 --max-seconds 60 \
       --costmap "$cells" --costmap-resolution "$res" --out "$work" || status=$?
     stop_robot
     sed -n '/summary/,$p' "$work/onboard.log" | grep -iE 'viewer|pose vs truth' || true
