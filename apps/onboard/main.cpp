@@ -21,6 +21,7 @@
 #include "semap/onboard/replay_rig.hpp"
 #include "semap/onboard/service.hpp"
 #include "semap/onboard/stream_recorder.hpp"
+#include "semap/onboard/viewer.hpp"
 #include "semap/sim/report.hpp"
 #include "semap/sim/rig.hpp"
 
@@ -70,6 +71,8 @@ int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_confi
     report = std::make_unique<sim::SimReport>(*sim_rig, options.report_dir);
     pipeline.attach(*report);
   }
+  // viewer: the Foxglove WebSocket server and the built-in page (docs/viewer.md).
+  const std::unique_ptr<onboard::Viewer> viewer = onboard::start_viewer(pipeline, config);
   std::vector<std::filesystem::path> save_paths;
   if (!config.map.save_path.empty()) save_paths.emplace_back(config.map.save_path);
   if (!options.report_dir.empty()) save_paths.push_back(report->dir() / "map.smap");

@@ -18,6 +18,10 @@ HealthMessage::HealthMessage(const HealthReport& r, const std::string& frame_id)
     writers_.push_back({const_cast<char*>(w.name.c_str()), const_cast<char*>(w.path.c_str()),
                         w.writes, w.failures, w.failing, const_cast<char*>(w.last_error.c_str())});
   }
+  for (const auto& v : r.viewers) {
+    viewers_.push_back({const_cast<char*>(v.address.c_str()), v.bytes_sent, v.messages_sent,
+                        v.messages_dropped, v.connected_s});
+  }
   msg_.header_.stamp_ = to_msg_time(r.stamp);
   msg_.header_.frame_id_ = const_cast<char*>(frame_id.c_str());
   msg_.stages_ = borrow_sequence<dds_sequence_semap_msgs_msg_dds__StageHealth_>(stages_.data(),
@@ -26,6 +30,8 @@ HealthMessage::HealthMessage(const HealthReport& r, const std::string& frame_id)
       drivers_.data(), drivers_.size());
   msg_.writers_ = borrow_sequence<dds_sequence_semap_msgs_msg_dds__WriterHealth_>(writers_.data(),
                                                                                   writers_.size());
+  msg_.viewers_ = borrow_sequence<dds_sequence_semap_msgs_msg_dds__ViewerClient_>(viewers_.data(),
+                                                                                  viewers_.size());
 }
 
 HealthReport from_msg(const msg::Health& m) {
@@ -46,6 +52,11 @@ HealthReport from_msg(const msg::Health& m) {
     const auto& w = m.writers_._buffer[i];
     r.writers.push_back({w.name_ ? w.name_ : "", w.path_ ? w.path_ : "", w.writes_, w.failures_,
                          w.failing_, w.last_error_ ? w.last_error_ : ""});
+  }
+  for (std::uint32_t i = 0; i < m.viewers_._length; ++i) {
+    const auto& v = m.viewers_._buffer[i];
+    r.viewers.push_back({v.address_ ? v.address_ : "", v.bytes_sent_, v.messages_sent_,
+                         v.messages_dropped_, v.connected_s_});
   }
   return r;
 }

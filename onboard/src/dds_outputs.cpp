@@ -32,23 +32,37 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
       map_publisher_(participant_,
                      dds_idl::MapPublisherConfig{config.ns, config.frame_id, config.publish_hz,
                                                  config.cloud_hz},
-                     map, map_blocks) {
+                     map, map_blocks),
+      sensor_frames_(sensor_frames) {
   dds_idl::set_stamp_clock(config.stamp_clock);
-  if (!sensor_frames.empty()) {
-    const common::Stamp now = common::Stamp::now();
-    std::vector<dds_idl::msg::TransformStamped> transforms(sensor_frames.size());
-    for (std::size_t i = 0; i < sensor_frames.size(); ++i) {
-      dds_idl::to_msg(sensor_frames[i].body_from_sensor, now, config.base_frame_id,
-                      sensor_frames[i].name, transforms[i]);
-    }
-    dds_idl::msg::TFMessage m{};
-    m.transforms_ = dds_idl::borrow_sequence<dds_sequence_geometry_msgs_msg_dds__TransformStamped_>(
-        transforms.data(), transforms.size());
-    tf_static_writer_.write(m);
-  }
+  write_tf_static();
   if (costmap && costmaps != nullptr) {
     costmap_.emplace(participant_, config.ns, config.frame_id, *costmap, *costmaps);
   }
+}
+
+void DdsOutputs::write_tf_static() {
+  if (sensor_frames_.empty()) return;
+  const common::Stamp now = common::Stamp::now();
+  std::vector<dds_idl::msg::TransformStamped> transforms(sensor_frames_.size());
+  for (std::size_t i = 0; i < sensor_frames_.size(); ++i) {
+    dds_idl::to_msg(sensor_frames_[i].body_from_sensor, now, config_.base_frame_id,
+                    sensor_frames_[i].name, transforms[i]);
+  }
+  dds_idl::msg::TFMessage m{};
+  m.transforms_ = dds_idl::borrow_sequence<dds_sequence_geometry_msgs_msg_dds__TransformStamped_>(
+      transforms.data(), transforms.size());
+  tf_static_writer_.write(m);
+}
+
+void DdsOutputs::attach_tap(dds_idl::MessageTap& tap) {
+  odometry_writer_.attach_tap(tap);
+  tf_writer_.attach_tap(tap);
+  tf_static_writer_.attach_tap(tap);
+  health_writer_.attach_tap(tap);
+  map_publisher_.attach_tap(tap);
+  if (costmap_) costmap_->attach_tap(tap);
+  write_tf_static();  // the tap's copy (a DDS reader gets the same transforms again)
 }
 
 // Only joins: the map view may be gone by now (stop() is what publishes the last changes).

@@ -1,5 +1,7 @@
 #include "semap/onboard/onboard_config.hpp"
 
+#include <arpa/inet.h>
+
 #include <cmath>
 #include <numbers>
 
@@ -183,6 +185,27 @@ void read_dds(const ConfigSection& s, DdsConfig& dds) {
   s.finish();
 }
 
+void read_viewer(const ConfigSection& s, ViewerConfig& v) {
+  v.enabled = s.get<bool>("enabled", v.enabled);
+  v.address = s.get<std::string>("address", v.address);
+  in6_addr probe{};
+  if (inet_pton(AF_INET, v.address.c_str(), &probe) != 1 &&
+      inet_pton(AF_INET6, v.address.c_str(), &probe) != 1) {
+    s.reject("address",
+             "must be an IPv4 or IPv6 address (127.0.0.1: this computer only; "
+             "0.0.0.0: every network)");
+  }
+  const double port = s.get_in_range("port", v.port, 0, 65535);
+  if (port != std::floor(port)) s.reject("port", "must be a whole number (0: any free port)");
+  v.port = static_cast<int>(port);
+  v.token = s.get<std::string>("token", v.token);
+  v.client_budget_bytes = static_cast<std::size_t>(s.get_in_range(
+      "client_budget_bytes", static_cast<double>(v.client_budget_bytes), 64.0 * 1024, 1e10));
+  v.image_hz = s.get_in_range("image_hz", v.image_hz, 0.0, 30.0);
+  v.jpeg_quality = static_cast<int>(s.get_in_range("jpeg_quality", v.jpeg_quality, 1, 100));
+  s.finish();
+}
+
 }  // namespace
 
 OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKeys& rig_keys) {
@@ -236,6 +259,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
   }
   if (c.gnss.lever_arm) c.estimator.lever_arm = c.gnss.lever_arm->cast<double>();
   read_dds(root.section_or_empty("dds"), c.dds);
+  read_viewer(root.section_or_empty("viewer"), c.viewer);
   const auto realtime = root.section_or_empty("realtime");
   c.realtime.lock_memory = realtime.get<bool>("lock_memory", c.realtime.lock_memory);
   if (realtime.has("stage_cpus")) {

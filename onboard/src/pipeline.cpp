@@ -167,9 +167,11 @@ void Pipeline::tick() {
   const auto now = common::Stamp::now();
   if (dds_ && now >= next_health_) {
     next_health_ = now + 1.0;
-    dds_->publish_health(health_.report(
+    auto report = health_.report(
         now, stage_figures(rings(), *estimation_, perception_.get(), *mapping_, *dds_),
-        rig_->drivers().health(), writers()));
+        rig_->drivers().health(), writers());
+    for (const PipelineObserver* o : observers_) o->viewer_clients(report.viewers);
+    dds_->publish_health(report);
   }
   if (now >= next_progress_) {
     next_progress_ = now + 5.0;

@@ -49,11 +49,22 @@ struct WriterHealthData {
   std::string last_error;
 };
 
+// A client of the viewer's WebSocket server (viewer:): what it was sent and what was dropped
+// because it was behind its byte budget.
+struct ViewerClientData {
+  std::string address;  // "127.0.0.1:53412"
+  std::uint64_t bytes_sent = 0;
+  std::uint64_t messages_sent = 0;
+  std::uint64_t messages_dropped = 0;
+  float connected_s = 0.0f;
+};
+
 struct HealthReport {
   common::Stamp stamp;
   std::vector<StageHealthData> stages;
   std::vector<DriverCountersData> drivers;
   std::vector<WriterHealthData> writers;
+  std::vector<ViewerClientData> viewers;
 };
 
 // A Health message borrowing the report's strings: valid while the report lives unchanged.
@@ -68,6 +79,7 @@ class HealthMessage {
   std::vector<msg::StageHealth> stages_;
   std::vector<msg::DriverCounters> drivers_;
   std::vector<msg::WriterHealth> writers_;
+  std::vector<msg::ViewerClient> viewers_;
   msg::Health msg_{};
 };
 

@@ -95,6 +95,13 @@ class MapPublisher {
   // source gives a block whose shape differs from the description.
   std::size_t publish_changed(common::Stamp now);
   void publish_cloud(common::Stamp now);
+  // Hands map_info, map_cloud and map_cloud_updates to `tap` as they are written (the blocks
+  // stay DDS-only). Before the publisher's thread starts.
+  void attach_tap(MessageTap& tap) {
+    info_writer_.attach_tap(tap);
+    cloud_writer_.attach_tap(tap);
+    updates_writer_.attach_tap(tap);
+  }
 
   std::size_t pending() const { return changed_.size(); }
   // Blocks published so far (a block the source later drops, such as a paged-out one, stays

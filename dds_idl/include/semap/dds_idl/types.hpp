@@ -10,6 +10,7 @@
 #include <semap_msgs/msg/Health_.h>
 #include <semap_msgs/msg/MapInfo_.h>
 #include <semap_msgs/msg/SemanticMapBlock_.h>
+#include <sensor_msgs/msg/CompressedImage_.h>
 #include <sensor_msgs/msg/Imu_.h>
 #include <sensor_msgs/msg/NavSatFix_.h>
 #include <sensor_msgs/msg/PointCloud2_.h>
@@ -35,7 +36,9 @@ using MapInfo = semap_msgs_msg_dds__MapInfo_;
 using StageHealth = semap_msgs_msg_dds__StageHealth_;
 using DriverCounters = semap_msgs_msg_dds__DriverCounters_;
 using WriterHealth = semap_msgs_msg_dds__WriterHealth_;
+using ViewerClient = semap_msgs_msg_dds__ViewerClient_;
 using Health = semap_msgs_msg_dds__Health_;
+using CompressedImage = sensor_msgs_msg_dds__CompressedImage_;
 }  // namespace msg
 
 template <typename T>
@@ -59,6 +62,7 @@ SEMAP_DDS_TYPE(msg::Health, semap_msgs_msg_dds__Health__desc);
 SEMAP_DDS_TYPE(msg::OccupancyGrid, nav_msgs_msg_dds__OccupancyGrid__desc);
 SEMAP_DDS_TYPE(msg::TFMessage, tf2_msgs_msg_dds__TFMessage__desc);
 SEMAP_DDS_TYPE(msg::OccupancyGridUpdate, map_msgs_msg_dds__OccupancyGridUpdate__desc);
+SEMAP_DDS_TYPE(msg::CompressedImage, sensor_msgs_msg_dds__CompressedImage__desc);
 
 #undef SEMAP_DDS_TYPE
 

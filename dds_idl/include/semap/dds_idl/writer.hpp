@@ -2,7 +2,10 @@
 
 #include <chrono>
 #include <thread>
+#include <vector>
 
+#include "semap/dds_idl/message_tap.hpp"
+#include "semap/dds_idl/ros2msg.hpp"
 #include "semap/dds_idl/topic.hpp"
 
 namespace semap::dds_idl {
@@ -30,7 +33,26 @@ class Writer {
     // The message is built only on failure: this is the hot path.
     const dds_return_t rc = dds_write(entity_.handle(), &sample);
     if (rc < 0) throw DdsError("dds_write " + topic_name_, rc);
+    if (tap_ != nullptr) {
+      // The bytes Cyclone sent (serialize_cdr writes them as its serdata does; Cyclone 0.10
+      // has no public way to hand a writer bytes of its sertype). One buffer per thread and
+      // type, so writers used from several threads stay independent.
+      static thread_local std::vector<std::uint8_t> cdr;
+      serialize_cdr(sample, cdr);
+      tap_->on_message(tap_id_, common::Stamp::now(), cdr);
+    }
   }
+
+  // From now on hands every sample written to `tap` too, on a channel named after the topic as
+  // ROS 2 sees it, latched when the writer is transient local. Before the threads that write
+  // start (the pointer is not synchronised).
+  void attach_tap(MessageTap& tap) {
+    TapChannel channel{ros2_topic_name(topic_name_),
+                       ros2_type_name(TypeDescriptor<T>::get()->m_typename), transient_local()};
+    tap_id_ = tap.add_channel(channel);
+    tap_ = &tap;
+  }
+  bool tapped() const { return tap_ != nullptr; }
 
   // Takes the instance whose key fields `key` holds out of the writer's history: readers keep
   // what they received, late joiners no longer get it. Writing it again registers it again.
@@ -63,8 +85,18 @@ class Writer {
   dds_entity_t handle() const { return entity_.handle(); }
 
  private:
+  bool transient_local() const {
+    dds_qos_t* qos = dds_create_qos();
+    dds_durability_kind_t kind = DDS_DURABILITY_VOLATILE;
+    if (dds_get_qos(entity_.handle(), qos) >= 0) dds_qget_durability(qos, &kind);
+    dds_delete_qos(qos);
+    return kind == DDS_DURABILITY_TRANSIENT_LOCAL;
+  }
+
   std::string topic_name_;
   Entity entity_;
+  MessageTap* tap_ = nullptr;
+  std::uint32_t tap_id_ = 0;
 };
 
 }  // namespace semap::dds_idl

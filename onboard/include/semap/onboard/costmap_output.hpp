@@ -63,6 +63,11 @@ class CostmapOutput {
   // Publisher thread: a round when one is due and the robot's position is known.
   void spin_once(common::Stamp now, const std::optional<Eigen::Vector2d>& robot);
   const Counters& counters() const { return counters_; }
+  // Hands the costmap and its updates to `tap` too; before the publisher's thread starts.
+  void attach_tap(dds_idl::MessageTap& tap) {
+    grid_writer_.attach_tap(tap);
+    update_writer_.attach_tap(tap);
+  }
 
  private:
   bool needs_rebuild(const Eigen::Vector2d& robot) const;

@@ -56,6 +56,10 @@ class DdsOutputs {
                       const std::vector<common::BlockIndex>& paged_out = {});
   // From the main thread, at 1 Hz.
   void publish_health(const dds_idl::HealthReport& report);
+  // Every message written from now on also goes to `tap` as the CDR DDS sends (odometry, tf,
+  // tf_static (written again for it), health, map_info, map_cloud and its updates, the
+  // costmap and its updates). Before start(), from the thread that calls start().
+  void attach_tap(dds_idl::MessageTap& tap);
 
   std::uint64_t odometry_written() const { return odometry_written_.load(); }
   std::uint64_t health_written() const { return health_written_; }
@@ -79,6 +83,7 @@ class DdsOutputs {
   dds_idl::Writer<dds_idl::msg::TFMessage> tf_static_writer_;
   dds_idl::Topic<dds_idl::msg::Health> health_topic_;
   dds_idl::Writer<dds_idl::msg::Health> health_writer_;
+  void write_tf_static();
   void run_publisher(std::stop_token stop);
   void take_changed();
   void update_counters();
@@ -91,6 +96,7 @@ class DdsOutputs {
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> changed_;
   std::unordered_set<common::BlockIndex, common::BlockIndexHash> paged_out_;
   std::uint64_t health_written_ = 0;  // main thread only
+  std::vector<SensorFrame> sensor_frames_;
   struct PublisherFigures {
     dds_idl::MapPublisherCounters counters;
     std::size_t pending = 0;

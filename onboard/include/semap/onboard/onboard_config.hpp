@@ -75,6 +75,19 @@ struct DdsConfig {
   dds_idl::StampClock stamp_clock = dds_idl::StampClock::kRealtime;
 };
 
+// The `viewer:` section: the Foxglove WebSocket server and built-in page (docs/viewer.md).
+struct ViewerConfig {
+  bool enabled = false;
+  // 127.0.0.1: only this computer (an SSH tunnel); 0.0.0.0 exposes it to every network.
+  std::string address = "127.0.0.1";
+  int port = 8765;    // 0: any free port (the log line "viewer: http://..." says which)
+  std::string token;  // non-empty: every request must carry ?token=<token>
+  // Bytes waiting to be sent to one client beyond which its droppable messages are dropped.
+  std::size_t client_budget_bytes = 8u << 20;
+  double image_hz = 2.0;  // camera and overlay images (JPEG) per second, at most
+  int jpeg_quality = 75;
+};
+
 // The `map:` section: the live map and what the mapping stage does with it.
 struct MappingConfig {
   mapping::MapParams params;
@@ -122,6 +135,7 @@ struct OnboardConfig {
   MappingConfig map;
   std::optional<CostmapConfig> costmap;  // the `costmap:` section; published over DDS
   DdsConfig dds;
+  ViewerConfig viewer;
   RealtimeConfig realtime;
   std::string log_level = "info";
 };

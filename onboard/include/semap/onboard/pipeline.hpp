@@ -41,6 +41,8 @@ class PipelineObserver {
   virtual void on_mapped(std::span<const common::BlockIndex> /*changed*/) {}
   // The pipeline has stopped: every stage has emptied its input (the thread calling stop()).
   virtual void on_stopped() {}
+  // The viewer's clients, for the health report (the thread calling tick(), once a second).
+  virtual void viewer_clients(std::vector<dds_idl::ViewerClientData>&) const {}
   // Its lines for the exit summary (after stop()).
   virtual void summary(std::vector<std::string>&) const {}
   // The files it writes, for the health report (the thread calling tick(), once a second).
@@ -67,6 +69,12 @@ class Pipeline {
 
   // Before start().
   void attach(PipelineObserver& observer) { observers_.push_back(&observer); }
+  // Before start(): every message the DDS outputs write also goes to `tap` (the viewer, a
+  // recorder). False when there are no DDS outputs (dds.enabled: false).
+  bool attach_tap(dds_idl::MessageTap& tap) {
+    if (dds_) dds_->attach_tap(tap);
+    return dds_ != nullptr;
+  }
   SensorRig& rig() { return *rig_; }
   const SensorRig& rig() const { return *rig_; }
 
