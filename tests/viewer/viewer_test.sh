@@ -4,6 +4,8 @@
 #                                              then the odometry against the simulated truth
 #   viewer_test.sh page   ONBOARD CONFIG XML   chromium headless on the built-in page
 #   viewer_test.sh mcap   FILE.mcap|WRITER...  @mcap/core reads an MCAP file semap wrote
+#   viewer_test.sh record ONBOARD CONFIG XML   @mcap/core reads `semap-onboard --record RUN.mcap`
+#                                              of 12 s on the simulated rig (SIGTERM)
 # ws and page start semap-onboard on the simulated rig with a copy of CONFIG: its own map path,
 # DDS domain and namespace, and `viewer:` on a free port (the port is read from the log line
 # "viewer: http://127.0.0.1:PORT/"). Node packages: scripts/test-tools (a cache outside the
@@ -65,6 +67,23 @@ grep -q "namespace: $ns" "$work/sim.yaml" || fail "could not write the run's con
 
 report_args=()
 [[ "$mode" == ws ]] && report_args=(--report "$work/report")
+if [[ "$mode" == record ]]; then
+  cd "$root"
+  "$onboard" --config "$work/sim.yaml" --duration 120 --domain "$domain" --record "$work/run.mcap" \
+    >"$work/onboard.log" 2>&1 &
+  onboard_pid=$!
+  sleep 12 # SIGTERM ends the run as systemd would: exit 0, the file closed with its summary
+  kill -TERM "$onboard_pid"
+  status=0
+  wait "$onboard_pid" || status=$?
+  onboard_pid=""
+  [[ $status -eq 0 ]] || { tail -30 "$work/onboard.log"; fail "semap-onboard --record exited with $status"; }
+  grep -E '^recording' "$work/onboard.log" || true
+  [[ -f "$work/run.mcap" ]] || fail "no $work/run.mcap"
+  node "$here/mcap_read_test.js" --file "$work/run.mcap" --min-messages 1000 --truncate 1 \
+    --topics /semap/odometry,/semap/health,/semap/raw/can
+  exit
+fi
 cd "$root"
 "$onboard" --config "$work/sim.yaml" --duration 120 --domain "$domain" "${report_args[@]}" \
   >"$work/onboard.log" 2>&1 &
