@@ -110,8 +110,10 @@ void McapWriter::flush() {
 void McapWriter::write_chunk() {
   if (chunk_records_.empty()) return;
   Chunk chunk;
-  chunk.message_start_time = chunk_start_time_;
-  chunk.message_end_time = chunk_end_time_;
+  // A chunk of Schema and Channel records only has no time span; readers that use the index
+  // (@mcap/core) reject one that claims the last chunk's times without message indexes.
+  chunk.message_start_time = chunk_messages_ > 0 ? chunk_start_time_ : 0;
+  chunk.message_end_time = chunk_messages_ > 0 ? chunk_end_time_ : 0;
   chunk.uncompressed_size = chunk_records_.size();
   chunk.uncompressed_crc = crc32_update(0, chunk_records_);
   chunk.compression = compression_name(options_.compression);
