@@ -19,7 +19,8 @@ namespace sd = semap::dds_idl;
 namespace {
 
 // One line per Health sample, "health: <stage> rate .. | driver <name> frames .. | writer <name>
-// writes .. failures .. failing 0|1 error '..'", for people and for the end-to-end tests to parse.
+// writes .. failures .. failing 0|1 error '..' | viewer <address> bytes .. messages .. dropped ..
+// connected_s ..", for people and for the end-to-end tests to parse.
 void print_health(const sd::HealthReport& h) {
   std::cout << "health:";
   for (const auto& s : h.stages) {
@@ -37,6 +38,11 @@ void print_health(const sd::HealthReport& h) {
   for (const auto& w : h.writers) {
     std::cout << " writer " << w.name << " writes " << w.writes << " failures " << w.failures
               << " failing " << (w.failing ? 1 : 0) << " error '" << w.last_error << "' |";
+  }
+  for (const auto& v : h.viewers) {
+    std::cout << " viewer " << v.address << " bytes " << v.bytes_sent << " messages "
+              << v.messages_sent << " dropped " << v.messages_dropped << " connected_s "
+              << v.connected_s << " |";
   }
   std::cout << std::endl;
 }

@@ -360,8 +360,12 @@ class FoxgloveServer::Impl::Client : public std::enable_shared_from_this<Client>
   void fail(beast::error_code ec, const char* what) {
     if (failed_) return;
     failed_ = true;
+    // A client that went away (closed, or its process ended: reset, end of stream) is a
+    // normal end; anything else (a protocol error, a timeout) closed it on an error.
     const bool normal = ec == websocket::error::closed || ec == asio::error::operation_aborted ||
-                        ec == asio::error::eof || closing_;
+                        ec == asio::error::eof || ec == asio::error::connection_reset ||
+                        ec == asio::error::broken_pipe || ec == http::error::end_of_stream ||
+                        closing_;
     if (!normal) {
       common::logger("viewer")->info("viewer: client {} closed: {} ({})", address_, ec.message(),
                                      what);

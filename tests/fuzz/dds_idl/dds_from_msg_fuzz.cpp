@@ -103,12 +103,30 @@ void health(FuzzInput& in) {
     d.wakeup_max_ms_ = in.take<float>();
     d.longest_gap_s_ = in.take<float>();
   }
+  // The viewer's clients last, so inputs written before they existed read as before.
+  std::vector<msg::ViewerClient> viewers(in.take<std::uint8_t>() % (kMaxSequence + 1));
+  for (auto& v : viewers) {
+    v.address_ = name_at(in.take<std::uint8_t>());
+    v.bytes_sent_ = in.take<std::uint64_t>();
+    v.messages_sent_ = in.take<std::uint64_t>();
+    v.messages_dropped_ = in.take<std::uint64_t>();
+    v.connected_s_ = in.take<float>();
+  }
+  m.viewers_._length = m.viewers_._maximum = static_cast<std::uint32_t>(viewers.size());
+  m.viewers_._buffer = viewers.data();
   m.stages_._length = m.stages_._maximum = static_cast<std::uint32_t>(stages.size());
   m.stages_._buffer = stages.data();
   m.drivers_._length = m.drivers_._maximum = static_cast<std::uint32_t>(drivers.size());
   m.drivers_._buffer = drivers.data();
   const HealthReport r = from_msg(m);
-  if (r.stages.size() != stages.size() || r.drivers.size() != drivers.size()) std::abort();
+  if (r.stages.size() != stages.size() || r.drivers.size() != drivers.size() ||
+      r.viewers.size() != viewers.size()) {
+    std::abort();
+  }
+  for (std::size_t i = 0; i < viewers.size(); ++i) {
+    if (r.viewers[i].address != (viewers[i].address_ ? viewers[i].address_ : "")) std::abort();
+    if (r.viewers[i].messages_dropped != viewers[i].messages_dropped_) std::abort();
+  }
   for (std::size_t i = 0; i < stages.size(); ++i) {
     if (r.stages[i].name != (stages[i].name_ ? stages[i].name_ : "")) std::abort();
     if (r.stages[i].drops != stages[i].drops_) std::abort();

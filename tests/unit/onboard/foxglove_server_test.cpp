@@ -203,10 +203,12 @@ TEST(FoxgloveServer, ServerInfoAdvertiseSubscribeAndMessageFrames) {
                           .count();
   EXPECT_LT(std::abs(static_cast<double>(f.stamp_ns) - static_cast<double>(now_ns)), 1e9);
 
-  const auto clients = server.clients();
-  ASSERT_EQ(clients.size(), 1u);
-  EXPECT_GE(clients[0].messages_sent, 1u);
-  EXPECT_GT(clients[0].bytes_sent, f.payload.size());
+  // Counted once the server's write completes, which may be just after the client has it.
+  ASSERT_TRUE(eventually([&] {
+    const auto clients = server.clients();
+    return clients.size() == 1 && clients[0].messages_sent >= 1;
+  }));
+  EXPECT_GT(server.clients()[0].bytes_sent, f.payload.size());
 
   // Unsubscribed: no more frames; the server keeps serving.
   client.send({{"op", "unsubscribe"}, {"subscriptionIds", {42}}});

@@ -110,5 +110,20 @@ TEST(WriteFailureLog, FirstFailureThenOneReminderPerIntervalThenTheRecovery) {
   EXPECT_EQ(log.lines(), 4u);
 }
 
+// The viewer's clients (what each was sent and lost for being behind) through the message.
+TEST(HealthMonitor, ViewerClientsReachTheMessage) {
+  HealthMonitor m;
+  auto report = m.report(common::Stamp::from_seconds(5.0), {}, {}, {});
+  report.viewers.push_back({"127.0.0.1:50000", 123456, 789, 12, 3.5f});
+  const dds_idl::HealthMessage message(report, "base_link");
+  const auto back = dds_idl::from_msg(message.get());
+  ASSERT_EQ(back.viewers.size(), 1u);
+  EXPECT_EQ(back.viewers[0].address, "127.0.0.1:50000");
+  EXPECT_EQ(back.viewers[0].bytes_sent, 123456u);
+  EXPECT_EQ(back.viewers[0].messages_sent, 789u);
+  EXPECT_EQ(back.viewers[0].messages_dropped, 12u);
+  EXPECT_FLOAT_EQ(back.viewers[0].connected_s, 3.5f);
+}
+
 }  // namespace
 }  // namespace semap::onboard

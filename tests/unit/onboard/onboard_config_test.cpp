@@ -51,6 +51,11 @@ TEST(OnboardConfig, SimulatedRigExample) {
   sim::SimRigConfig sim_rig;
   const auto c = load(kConfigDir / "sim.yaml", &sim_rig);
   EXPECT_EQ(c.rig.kind, RigKind::kSim);
+  // The viewer is on in the simulated rig's config, on loopback.
+  EXPECT_TRUE(c.viewer.enabled);
+  EXPECT_EQ(c.viewer.address, "127.0.0.1");
+  EXPECT_EQ(c.viewer.port, 8765);
+  EXPECT_TRUE(c.viewer.token.empty());
   EXPECT_EQ(c.camera.intrinsics.width, 640);
   EXPECT_EQ(c.camera.intrinsics.height, 480);
   EXPECT_DOUBLE_EQ(c.camera.driver.fps, 15.0);
@@ -84,6 +89,7 @@ TEST(OnboardConfig, TheSimulatedRigsKeysBelongToItsLibrary) {
 TEST(OnboardConfig, RgbdRobotExample) {
   const auto c = load(kConfigDir / "robot-rgbd.yaml");
   EXPECT_EQ(c.rig.kind, RigKind::kHardware);
+  EXPECT_FALSE(c.viewer.enabled);  // off on a robot unless its config turns it on
   EXPECT_EQ(c.camera.driver.device, "/dev/video0");
   EXPECT_EQ(c.camera.driver.format, common::PixelFormat::kYuyv);
   EXPECT_FLOAT_EQ(c.camera.intrinsics.fx, 615.0f);
@@ -224,6 +230,13 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
        "out of range"},
       {"  domain: 0", "  domain: 300", "dds.domain", "out of range"},
       {"  publish_hz: 2\n  cloud_hz", "  publish_hz: 0\n  cloud_hz", "dds.publish_hz",
+       "out of range"},
+      {"  port: 8765", "  port: 70000", "viewer.port", "out of range"},
+      {"  port: 8765", "  port: 80.5", "viewer.port", "whole number"},
+      {"  address: 127.0.0.1 ", "  address: robot.local ", "viewer.address", "IPv4 or IPv6"},
+      {"  image_hz: 2 ", "  image_hz: 100 ", "viewer.image_hz", "out of range"},
+      {"  jpeg_quality: 75", "  jpeg_quality: 0", "viewer.jpeg_quality", "out of range"},
+      {"  client_budget_bytes: 8388608", "  client_budget_bytes: 10", "viewer.client_budget_bytes",
        "out of range"},
       {"  model_card: models/semap-seg.yaml", "  model_card: models/missing.yaml",
        "segmenter.model_card", "models/missing.yaml"},
