@@ -1,14 +1,17 @@
 // semap-onboard: the robot's main job. Reads the configuration, chooses the sensor rig (the
 // robot's devices, a recording, or the built-in simulated rig), runs the pipeline
 // (onboard::Pipeline) until it is stopped or the rig has played all it had, saves the map and
-// prints the summary. --record DIR saves the raw sensor streams; --report DIR (simulated rig)
-// writes images, the map and summary.json scored against the simulated truth.
+// prints the summary. --record FILE.mcap saves the raw sensor streams and the outputs; --report DIR
+// (simulated rig) writes images, the map and summary.json scored against the simulated truth.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -17,10 +20,11 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/onboard/hardware_rig.hpp"
+#include "semap/onboard/mcap_recorder.hpp"
+#include "semap/onboard/mcap_recording.hpp"
 #include "semap/onboard/pipeline.hpp"
 #include "semap/onboard/replay_rig.hpp"
 #include "semap/onboard/service.hpp"
-#include "semap/onboard/stream_recorder.hpp"
 #include "semap/onboard/viewer.hpp"
 #include "semap/sim/report.hpp"
 #include "semap/sim/rig.hpp"
@@ -35,7 +39,8 @@ void on_signal(int) { g_stop.store(true); }
 // What the command line adds to the configuration.
 struct RunOptions {
   std::string config_path;
-  std::string record_dir;
+  std::string record_file;
+  std::string record_compression = "zstd";
   std::string report_dir;
   std::string trajectory;
 };
@@ -59,11 +64,16 @@ int run(const onboard::OnboardConfig& config, const sim::SimRigConfig& sim_confi
         return rig;
       },
       options.trajectory);
-  std::unique_ptr<onboard::StreamRecorder> recorder;
-  if (!options.record_dir.empty()) {
-    recorder = std::make_unique<onboard::StreamRecorder>(
-        options.record_dir, options.config_path,
-        config.imu.interface.empty() ? "sim" : config.imu.interface);
+  std::unique_ptr<onboard::McapRecorder> recorder;
+  if (!options.record_file.empty()) {
+    onboard::McapRecorderOptions record;
+    record.can_interface = config.imu.interface.empty() ? "sim" : config.imu.interface;
+    record.writer.compression =
+        options.record_compression == "lz4"    ? drivers::mcap::Compression::kLz4
+        : options.record_compression == "none" ? drivers::mcap::Compression::kNone
+                                               : drivers::mcap::Compression::kZstd;
+    recorder =
+        std::make_unique<onboard::McapRecorder>(options.record_file, options.config_path, record);
     recorder->attach(pipeline);
   }
   std::unique_ptr<sim::SimReport> report;
@@ -102,17 +112,23 @@ int main(int argc, char** argv) {
       "could not be saved at exit (the checkpoint log keeps it: --resume).");
   RunOptions options;
   std::string replay_dir, pace, save_path;
+  std::filesystem::path extracted_config;  // --replay FILE.mcap: its configuration, for loading
   std::optional<double> duration;
   std::optional<int> domain;
   bool resume = false;
   app.add_option("--config", options.config_path,
                  "YAML configuration (see config/sim.yaml); with --replay, the recording's")
       ->check(CLI::ExistingFile);
-  app.add_option("--record", options.record_dir,
-                 "save the raw sensor streams into this new directory (docs/record-replay.md)");
+  app.add_option("--record", options.record_file,
+                 "record the raw sensor streams and the outputs into this new MCAP file "
+                 "(docs/record-replay.md)");
+  app.add_option("--record-compression", options.record_compression,
+                 "the recording's chunk compression: zstd (default) | lz4 | none")
+      ->check(CLI::IsMember({"zstd", "lz4", "none"}));
   app.add_option("--replay", replay_dir,
-                 "play back a recording made with --record (rig.kind: replay, rig.replay: DIR)")
-      ->check(CLI::ExistingDirectory)
+                 "play back a recording made with --record (rig.kind: replay, rig.replay: "
+                 "FILE.mcap, or the directory of a recording of the older format)")
+      ->check(CLI::ExistingPath)
       ->excludes("--record");
   app.add_option("--pace", pace, "replay pace, overrides rig.pace: recorded | fast")
       ->check(CLI::IsMember({"recorded", "fast"}));
@@ -132,7 +148,21 @@ int main(int argc, char** argv) {
     std::cerr << "semap-onboard: --config is required (or --replay DIR)\n";
     return 2;
   }
-  if (options.config_path.empty()) options.config_path = replay_dir + "/config.yaml";
+  if (options.config_path.empty() && std::filesystem::is_directory(replay_dir)) {
+    options.config_path = replay_dir + "/config.yaml";
+  } else if (options.config_path.empty()) {
+    // An MCAP recording holds its configuration: loaded from a copy beside nothing else.
+    try {
+      const std::string text = onboard::recorded_config(replay_dir);
+      extracted_config = std::filesystem::temp_directory_path() /
+                         ("semap-replay-" + std::to_string(::getpid()) + ".yaml");
+      std::ofstream(extracted_config) << text;
+      options.config_path = extracted_config.string();
+    } catch (const std::exception& e) {
+      std::cerr << "semap-onboard: --replay " << e.what() << "\n";
+      return 2;
+    }
+  }
 
   onboard::OnboardConfig config;
   sim::SimRigConfig sim_config;
@@ -156,16 +186,18 @@ int main(int argc, char** argv) {
       config.map.checkpoint_path = options.report_dir + "/map.log";
     }
     onboard::check_paths(config, options.config_path);
-    if (!options.record_dir.empty() && config.rig.kind == onboard::RigKind::kReplay) {
+    if (!options.record_file.empty() && config.rig.kind == onboard::RigKind::kReplay) {
       throw std::invalid_argument("--record cannot record a replay");
     }
     if (!options.report_dir.empty() && config.rig.kind != onboard::RigKind::kSim) {
       throw std::invalid_argument("--report needs the simulated rig (rig.kind: sim)");
     }
   } catch (const std::exception& e) {
+    if (!extracted_config.empty()) std::filesystem::remove(extracted_config);
     std::cerr << "semap-onboard: " << e.what() << "\n";
     return 2;
   }
+  if (!extracted_config.empty()) std::filesystem::remove(extracted_config);
   common::setup_logging(config.log_level);
   if (config.dds.enabled && !config.dds.cyclone_config.empty() && !std::getenv("CYCLONEDDS_URI")) {
     setenv("CYCLONEDDS_URI", ("file://" + config.dds.cyclone_config.string()).c_str(), 1);

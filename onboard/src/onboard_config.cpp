@@ -31,10 +31,10 @@ void read_rig(const ConfigSection& s, RigConfig& rig) {
                                   : RigKind::kReplay;
   rig.replay = s.get<std::string>("replay", "");
   if (rig.kind == RigKind::kReplay && rig.replay.empty()) {
-    s.reject("replay", "rig.kind: replay needs the recording's directory");
+    s.reject("replay", "rig.kind: replay needs the recording (FILE.mcap, or an older DIR)");
   }
-  if (rig.kind == RigKind::kReplay && !std::filesystem::is_directory(rig.replay)) {
-    s.reject("replay", rig.replay.string() + " is not a directory");
+  if (rig.kind == RigKind::kReplay && !std::filesystem::exists(rig.replay)) {
+    s.reject("replay", rig.replay.string() + " does not exist");
   }
   rig.pace = s.get_choice("pace", "recorded", {"recorded", "fast"}) == "fast"
                  ? ReplayPace::kFast

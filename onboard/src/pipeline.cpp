@@ -120,6 +120,7 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
 Pipeline::~Pipeline() { stop(); }
 
 void Pipeline::start() {
+  taps_.seal();
   if (config_.realtime.lock_memory) {
     memory_lock_ = drivers::lock_memory();
     if (memory_lock_.empty()) {

@@ -7,7 +7,6 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/onboard/rig_clock.hpp"
-#include "semap/onboard/stream_recorder.hpp"
 
 namespace semap::onboard {
 
@@ -38,6 +37,48 @@ ReplayRig::ReplayRig(const OnboardConfig& config, const SensorRings& rings)
       depth_ring_(rings.depth),
       imu_decoder_(config.imu.driver.decoder),
       gnss_decoder_(config.gnss.driver.fix) {
+  const std::filesystem::path& path = config.rig.replay;
+  std::optional<common::Stamp> first;
+  const auto earliest = [&](common::Stamp s) { first = first ? std::min(*first, s) : s; };
+  if (std::filesystem::is_directory(path)) {
+    open_directory(config);
+    if (imu_next_) earliest(stamp_of(*imu_next_));
+    if (gnss_next_) earliest(gnss_next_->stamp);
+    if (colour_) earliest(colour_->next->stamp);
+    if (depth_) earliest(depth_->next->stamp);
+  } else {
+    if (!is_mcap_file(path)) {
+      throw std::runtime_error("rig.replay: " + path.string() +
+                               " is neither an MCAP recording nor a recording's directory");
+    }
+    mcap_ = std::make_unique<McapRecordingReader>(path);
+    mcap_->fill();
+    const auto front = [&](const auto& queue) {
+      if (!queue.empty()) earliest(queue.front().stamp);
+    };
+    front(mcap_->can);
+    front(mcap_->gnss);
+    front(mcap_->colour);
+    front(mcap_->depth);
+    if (!first) {
+      throw std::runtime_error("rig.replay: " + path.string() + " holds no inputs" +
+                               (mcap_->error().empty() ? "" : ": " + mcap_->error()));
+    }
+    // Whether a camera was recorded: its first frame within the recording's first 30 s.
+    McapRecordingReader probe(path, 30'000'000'000);
+    probe.fill();
+    mcap_camera_ = !probe.colour.empty();
+  }
+  if (pace_ == ReplayPace::kRecorded) {
+    pty_ = std::make_unique<PseudoTerminal>();
+    auto gnss = config.gnss.driver;
+    gnss.serial.device = pty_->slave_name();
+    drivers_.add_gnss(gnss, rings.gnss);
+    offset_ns_ = (common::Stamp::now() + kStartDelay_s).ns - first->ns;
+  }
+}
+
+void ReplayRig::open_directory(const OnboardConfig& config) {
   const std::filesystem::path& dir = config.rig.replay;
   open(imu_file_, dir / RecordingFiles::kImu);
   imu_reader_ = std::make_unique<firmware_bridge::CandumpReader>(
@@ -64,19 +105,6 @@ ReplayRig::ReplayRig(const OnboardConfig& config, const SensorRings& rings)
   advance_gnss();
   if (!imu_next_ && !gnss_next_ && !colour_) {
     throw std::runtime_error("rig.replay: " + dir.string() + " holds no records");
-  }
-  if (pace_ == ReplayPace::kRecorded) {
-    pty_ = std::make_unique<PseudoTerminal>();
-    auto gnss = config.gnss.driver;
-    gnss.serial.device = pty_->slave_name();
-    drivers_.add_gnss(gnss, rings.gnss);
-    std::optional<common::Stamp> first;
-    const auto earliest = [&](common::Stamp s) { first = first ? std::min(*first, s) : s; };
-    if (imu_next_) earliest(stamp_of(*imu_next_));
-    if (gnss_next_) earliest(gnss_next_->stamp);
-    if (colour_) earliest(colour_->next->stamp);
-    if (depth_) earliest(depth_->next->stamp);
-    offset_ns_ = (common::Stamp::now() + kStartDelay_s).ns - first->ns;
   }
 }
 
@@ -161,14 +189,14 @@ void ReplayRig::wait_settled(std::stop_token stop) {
   }
 }
 
-void ReplayRig::play_imu(common::Stamp stamp, std::stop_token stop) {
-  const SemapCandumpRecord& r = *imu_next_;
-  if (r.kind != SEMAP_CANDUMP_DATA) {
+void ReplayRig::play_can(const SemapCanFrame& frame, bool error_frame, common::Stamp stamp,
+                         std::stop_token stop) {
+  if (error_frame) {
     std::lock_guard lock(mutex_);
     ++counters_.can_error_frames;
     return;
   }
-  const auto sample = imu_decoder_.push(r.frame, stamp);
+  const auto sample = imu_decoder_.push(frame, stamp);
   {
     std::lock_guard lock(mutex_);
     ++counters_.can_frames;
@@ -179,8 +207,8 @@ void ReplayRig::play_imu(common::Stamp stamp, std::stop_token stop) {
   ++counters_.imu_samples;
 }
 
-void ReplayRig::play_gnss(common::Stamp stamp, std::stop_token stop) {
-  const std::vector<std::uint8_t>& bytes = gnss_next_->bytes;
+void ReplayRig::play_gnss(const std::vector<std::uint8_t>& bytes, common::Stamp stamp,
+                          std::stop_token stop) {
   if (pty_) {
     if (const std::size_t lost = pty_->write(bytes); lost > 0) {
       common::logger("replay")->warn("{} GNSS bytes not taken by the driver", lost);
@@ -197,9 +225,8 @@ void ReplayRig::play_gnss(common::Stamp stamp, std::stop_token stop) {
   counters_.gnss_fixes += fixes_.size();
 }
 
-void ReplayRig::play_frame(FrameStream& stream, common::SpscRing<common::ImageFrame>& ring,
+void ReplayRig::play_frame(common::ImageFrame frame, common::SpscRing<common::ImageFrame>& ring,
                            bool colour, std::stop_token stop) {
-  common::ImageFrame frame = std::move(*stream.next);
   frame.stamp = common::Stamp(frame.stamp.ns + offset_ns_);
   if (colour) wait_settled(stop);
   push(ring, std::move(frame), stop);
@@ -221,29 +248,67 @@ void ReplayRig::run(std::stop_token stop) {
         at = stamp;
       }
     };
-    if (imu_next_) consider(Next::kImu, stamp_of(*imu_next_));
-    if (gnss_next_) consider(Next::kGnss, gnss_next_->stamp);
-    if (depth_ && depth_->next) consider(Next::kDepth, depth_->next->stamp);
-    if (colour_ && colour_->next) consider(Next::kColour, colour_->next->stamp);
-    if (next == Next::kNone) break;
+    if (mcap_) {
+      mcap_->fill();
+      if (!mcap_->can.empty()) consider(Next::kImu, mcap_->can.front().stamp);
+      if (!mcap_->gnss.empty()) consider(Next::kGnss, mcap_->gnss.front().stamp);
+      if (!mcap_->depth.empty()) consider(Next::kDepth, mcap_->depth.front().stamp);
+      if (!mcap_->colour.empty()) consider(Next::kColour, mcap_->colour.front().stamp);
+    } else {
+      if (imu_next_) consider(Next::kImu, stamp_of(*imu_next_));
+      if (gnss_next_) consider(Next::kGnss, gnss_next_->stamp);
+      if (depth_ && depth_->next) consider(Next::kDepth, depth_->next->stamp);
+      if (colour_ && colour_->next) consider(Next::kColour, colour_->next->stamp);
+    }
+    if (next == Next::kNone) {
+      if (mcap_) note_error(mcap_->error());
+      break;
+    }
     const common::Stamp stamp(at.ns + offset_ns_);
     if (pace_ == ReplayPace::kRecorded) sleep_until(stamp, stop);
+    if (mcap_) {
+      switch (next) {
+        case Next::kImu:
+          play_can(mcap_->can.front().frame, mcap_->can.front().error_frame, stamp, stop);
+          mcap_->can.pop_front();
+          break;
+        case Next::kGnss:
+          play_gnss(mcap_->gnss.front().bytes, stamp, stop);
+          mcap_->gnss.pop_front();
+          break;
+        case Next::kDepth:
+          play_frame(std::move(mcap_->depth.front()), depth_ring_, false, stop);
+          mcap_->depth.pop_front();
+          break;
+        case Next::kColour:
+          play_frame(std::move(mcap_->colour.front()), colour_ring_, true, stop);
+          mcap_->colour.pop_front();
+          break;
+        case Next::kNone:
+          break;
+      }
+      continue;
+    }
     switch (next) {
       case Next::kImu:
-        play_imu(stamp, stop);
+        if (imu_next_->kind != SEMAP_CANDUMP_DATA) {
+          play_can(imu_next_->frame, true, stamp, stop);
+        } else {
+          play_can(imu_next_->frame, false, stamp, stop);
+        }
         advance_imu();
         break;
       case Next::kGnss:
-        play_gnss(stamp, stop);
+        play_gnss(gnss_next_->bytes, stamp, stop);
         advance_gnss();
         break;
       case Next::kDepth:
-        play_frame(*depth_, depth_ring_, false, stop);
+        play_frame(std::move(*depth_->next), depth_ring_, false, stop);
         advance(*depth_);
         if (!depth_->next) note_error(depth_->reader->error());
         break;
       case Next::kColour:
-        play_frame(*colour_, colour_ring_, true, stop);
+        play_frame(std::move(*colour_->next), colour_ring_, true, stop);
         advance(*colour_);
         if (!colour_->next) note_error(colour_->reader->error());
         break;

@@ -3,10 +3,10 @@
 # robot checkpoints every second while a planner-side listener follows its health over DDS:
 #
 #   ulimit  the process runs under a 4 MiB file-size limit (ulimit -f; semap-onboard ignores
-#           SIGXFSZ, so writes fail with EFBIG) and records its sensor streams (--record): the
-#           camera log reaches the limit at once, the checkpoint log a few seconds into mapping,
-#           and the map saved at SIGTERM does not fit either. The recording must replay to its
-#           end without damage.
+#           SIGXFSZ, so writes fail with EFBIG) and records its sensor streams and outputs
+#           (--record rec.mcap): the recording reaches the limit in a few seconds, the checkpoint
+#           log a few seconds into mapping, and the map saved at SIGTERM does not fit either. The
+#           recording must replay up to its last whole chunk, with no torn chunk at its end.
 #   tmpfs   (root, mount permitted; else skipped with exit 77) the map lives on a 32 MiB tmpfs
 #           that a filler file leaves 3 MiB of: checkpoints fail with ENOSPC; then the filler
 #           is deleted, writing must resume and the map saved at SIGTERM fits.
@@ -62,7 +62,7 @@ else
   (
     ulimit -f 4096 # KiB: 4 MiB per file
     exec "$onboard" --config "$work/sim.yaml" --duration 120 --domain "$domain" \
-      --record "$disk/rec"
+      --record "$disk/rec.mcap"
   ) >"$work/run.log" 2>&1 &
 fi
 pid=$!
@@ -153,23 +153,31 @@ else
   size=$(stat -c %s "$disk/map.smap.log")
   [[ $size -le $((4096 * 1024)) ]] || fail "the log is past the limit ($size bytes)"
   # The recorder: counted, named, in health; its files whole and replayable to their end.
-  grep -Eq "recording        : $disk/rec: .* [1-9][0-9]* write failures \(still failing at exit; last error: $disk/rec/(colour|depth).log: write: $errno_text\)" \
+  grep -Eq "recording        : $disk/rec.mcap: .* [1-9][0-9]* write failures \((still failing at exit|writing again); last error: $disk/rec.mcap: write: $errno_text\)" \
     "$work/run.log" || fail "the recording's failures are not in the summary"
-  grep -q "\[recorder\] \[error\] recording: $disk/rec/colour.log: write: $errno_text" \
+  grep -q "\[recorder\] \[error\] recording: $disk/rec.mcap: write: $errno_text" \
     "$work/run.log" || fail "the recording's failure is not logged"
+  recorder_errors=$(grep -c "\[recorder\] \[error\]" "$work/run.log" || true)
+  [[ $recorder_errors -le 5 ]] || fail "$recorder_errors recorder error lines: not rate-limited"
   grep -q "writer recorder [^|]* failing 1 error '[^']*$errno_text'" "$work/listener.log" ||
     fail "no health report with the recorder failing"
-  "$onboard" --replay "$disk/rec" --pace fast --save "$work/replay.smap" --domain "$domain" \
+  "$onboard" --replay "$disk/rec.mcap" --pace fast --save "$work/replay.smap" --domain "$domain" \
     >"$work/replay.log" 2>&1 || true
   grep -q "^replay           : [1-9][0-9]* CAN frames" "$work/replay.log" || {
     cat "$work/replay.log"
     fail "the recording does not replay"
   }
-  grep -q "^replay           : .*damaged" "$work/replay.log" && {
+  # Either its end fitted under the limit at exit (a complete file: the chunks that did not
+  # fit are lost, the others are whole), or it reads to its last whole chunk, which is where the
+  # file ends (a failed chunk was cut off again, nothing torn).
+  size=$(stat -c %s "$disk/rec.mcap")
+  ! grep -q "^replay           : .*damaged" "$work/replay.log" ||
+    grep -q "^replay           : .*damaged: $disk/rec.mcap: truncated at byte $size:" \
+      "$work/replay.log" || {
     grep "^replay  " "$work/replay.log"
-    fail "the recording has a torn record"
+    fail "the recording does not end after its last whole chunk ($size bytes)"
   }
-  say "recording: $(grep -o "[0-9]* write failures (still failing" "$work/run.log"), replayed:" \
+  say "recording: $(grep -o "[0-9]* write failures ([a-z ]*" "$work/run.log"), replayed:" \
     "$(grep "^replay  " "$work/replay.log")"
 fi
 

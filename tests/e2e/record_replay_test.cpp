@@ -1,7 +1,8 @@
-// semap-onboard --record on the simulated rig, then the recording replayed (rig.kind: replay):
-// as fast as possible it must give the recorded run's trajectory (within 1 mm) and map (the same
-// occupied cells and classes); at recorded pace, with the GNSS bytes through a pty to the real
-// driver, nearly the same; a damaged recording plays up to the damage and names it. The plain
+// semap-onboard --record RUN.mcap on the simulated rig, then the recording replayed (rig.kind:
+// replay): as fast as possible it must give the recorded run's trajectory (within 1 mm) and map
+// (the same occupied cells and classes); at recorded pace, with the GNSS bytes through a pty to
+// the real driver, nearly the same; a recording cut off (a crash) plays up to its last whole
+// chunk and says so; semap-can extracts its CAN frames as a candump log. The plain
 // maths (map.engine: plain, estimator.covariance_window: 1) replayed as fast as possible gives
 // the defaults' trajectory and map.
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -18,10 +20,15 @@
 #include <vector>
 
 #include "semap/common/map_grid.hpp"
+#include "semap/dds_idl/message_tap.hpp"
+#include "semap/dds_idl/recording_types.hpp"
+#include "semap/drivers/mcap_message_reader.hpp"
 #include "semap/drivers/stream_log.hpp"
+#include "semap/firmware_bridge/candump_log.h"
 #include "semap/firmware_bridge/candump_reader.hpp"
 #include "semap/map_io/map_export.hpp"
 #include "semap/mapping/smap_io.hpp"
+#include "semap/onboard/mcap_recording.hpp"
 #include "support/cli_run.hpp"
 
 namespace {
@@ -30,6 +37,7 @@ namespace fs = std::filesystem;
 using semap::test_support::run_cli;
 
 const std::string kOnboard = SEMAP_ONBOARD;
+const std::string kCan = SEMAP_CAN;
 
 std::string slurp(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -131,9 +139,9 @@ class RecordReplay : public ::testing::Test {
             "save_path: " + (*dir_ / "live.smap").string());
     replace(config, "dds:\n", "dds:\n  enabled: false\n");
     std::ofstream(*dir_ / "live.yaml") << config;
-    live_ = new semap::test_support::CliResult(run_cli(
-        kOnboard, "--config " + (*dir_ / "live.yaml").string() + " --record " +
-                      (*dir_ / "rec").string() + " --trajectory " + (*dir_ / "live.csv").string()));
+    live_ = new semap::test_support::CliResult(
+        run_cli(kOnboard, "--config " + (*dir_ / "live.yaml").string() + " --record " +
+                              rec().string() + " --trajectory " + (*dir_ / "live.csv").string()));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
@@ -151,7 +159,7 @@ class RecordReplay : public ::testing::Test {
         << live_->out;
     ASSERT_NE(live_->out.find(" 0 passed over"), std::string::npos) << live_->out;
   }
-  static fs::path rec() { return *dir_ / "rec"; }
+  static fs::path rec() { return *dir_ / "rec.mcap"; }
 
   static fs::path* dir_;
   static semap::test_support::CliResult* live_;
@@ -160,9 +168,75 @@ fs::path* RecordReplay::dir_ = nullptr;
 semap::test_support::CliResult* RecordReplay::live_ = nullptr;
 
 TEST_F(RecordReplay, TheRecordingHoldsEveryStream) {
+  namespace dds = semap::dds_idl;
   const std::string& out = live_->out;
-  // The IMU as a candump -L log, each frame of the semap protocol under the rig's name.
-  std::ifstream imu(rec() / "imu.log");
+  semap::drivers::mcap::McapMessageReader reader(rec());
+  std::map<std::string, long long> counts;
+  long long gnss_bytes = 0, error_frames = 0;
+  std::string config;
+  while (const auto m = reader.next()) {
+    const std::string& topic = m->channel.topic;
+    ++counts[topic];
+    ASSERT_NE(m->schema, nullptr) << topic;
+    EXPECT_EQ(m->schema->encoding, "ros2msg");
+    EXPECT_EQ(m->channel.message_encoding, "cdr");
+    if (topic == dds::RecordingTopics::kCan) {
+      EXPECT_EQ(m->schema->name, "can_msgs/msg/Frame");
+      dds::msg::CanFrame f{};
+      ASSERT_TRUE(dds::deserialize_cdr(m->message.data, f));
+      EXPECT_STREQ(f.header_.frame_id_, "sim");
+      EXPECT_EQ(f.dlc_, 8);
+      // The log time is the driver's stamp.
+      EXPECT_EQ(m->message.log_time,
+                static_cast<std::uint64_t>(f.header_.stamp_.sec_) * 1'000'000'000ull +
+                    f.header_.stamp_.nanosec_);
+      error_frames += f.is_error_ ? 1 : 0;
+      dds_sample_free(&f, dds::TypeDescriptor<dds::msg::CanFrame>::get(), DDS_FREE_CONTENTS);
+    } else if (topic == dds::RecordingTopics::kGnss) {
+      dds::msg::GnssBytes g{};
+      ASSERT_TRUE(dds::deserialize_cdr(m->message.data, g));
+      gnss_bytes += g.data_._length;
+      dds_sample_free(&g, dds::TypeDescriptor<dds::msg::GnssBytes>::get(), DDS_FREE_CONTENTS);
+    } else if (topic == dds::RecordingTopics::kColour || topic == dds::RecordingTopics::kDepth) {
+      dds::msg::Image image{};
+      ASSERT_TRUE(dds::deserialize_cdr(m->message.data, image));
+      EXPECT_EQ(image.width_, 320u);
+      EXPECT_EQ(image.height_, 240u);
+      const std::string encoding = image.encoding_;
+      EXPECT_EQ(encoding, topic == dds::RecordingTopics::kDepth ? "16UC1" : "bgr8");
+      EXPECT_EQ(image.data_._length, image.step_ * image.height_);
+      dds_sample_free(&image, dds::TypeDescriptor<dds::msg::Image>::get(), DDS_FREE_CONTENTS);
+    } else if (topic == dds::RecordingTopics::kConfig) {
+      dds::msg::String text{};
+      ASSERT_TRUE(dds::deserialize_cdr(m->message.data, text));
+      config = text.data_;
+      dds_sample_free(&text, dds::TypeDescriptor<dds::msg::String>::get(), DDS_FREE_CONTENTS);
+    }
+  }
+  EXPECT_EQ(reader.status(), semap::drivers::mcap::McapReadStatus::kEnd) << reader.error();
+  const long long frames = counts[dds::RecordingTopics::kCan];
+  EXPECT_EQ(frames, figure(out, "recording        : " + rec().string() + ": "));
+  EXPECT_EQ(error_frames, 0);
+  // 3 frames per sample of the semap profile.
+  EXPECT_EQ(frames, 3 * figure(out, "estimation       : ")) << out;
+  // The GNSS port's bytes, all the driver read.
+  EXPECT_EQ(gnss_bytes, figure(out, "fixes, ")) << out;
+  // Camera frames, every one the perception stage took.
+  EXPECT_EQ(counts[dds::RecordingTopics::kColour], figure(out, "perception       : "));
+  EXPECT_EQ(counts[dds::RecordingTopics::kDepth], figure(out, "perception       : "));
+  EXPECT_EQ(config, slurp(*dir_ / "live.yaml"));
+  // No DDS in this run: no outputs.
+  EXPECT_EQ(counts.size(), 5u);
+}
+
+// semap-can extracts the CAN frames as a candump -L log: can-utils read it (log2asc), and
+// semap-can decodes it to the IMU samples the robot estimated with.
+TEST_F(RecordReplay, SemapCanExtractsACandumpLog) {
+  const fs::path log = *dir_ / "imu.log";
+  const auto extract =
+      run_cli(kCan, "--from-mcap " + rec().string() + " --candump " + log.string());
+  ASSERT_EQ(extract.status, 0) << extract.out;
+  std::ifstream imu(log);
   semap::firmware_bridge::CandumpReader candump(imu, "imu.log");
   long long frames = 0;
   while (const auto r = candump.next()) {
@@ -170,10 +244,9 @@ TEST_F(RecordReplay, TheRecordingHoldsEveryStream) {
     ++frames;
   }
   EXPECT_EQ(candump.error(), "");
-  EXPECT_EQ(frames, figure(out, "recording        : " + rec().string() + ": "));
-  // can-utils reads it as its own: log2asc converts every line.
+  EXPECT_EQ(frames, figure(live_->out, "recording        : " + rec().string() + ": "));
   if (fs::exists("/usr/bin/log2asc")) {
-    const auto asc = run_cli("/usr/bin/log2asc", "-I " + (rec() / "imu.log").string() + " sim");
+    const auto asc = run_cli("/usr/bin/log2asc", "-I " + log.string() + " sim");
     ASSERT_EQ(asc.status, 0) << asc.out.substr(0, 500);
     long long rx = 0;
     for (std::size_t at = asc.out.find(" Rx "); at != std::string::npos;
@@ -182,31 +255,18 @@ TEST_F(RecordReplay, TheRecordingHoldsEveryStream) {
     }
     EXPECT_EQ(rx, frames);
   }
-  // 3 frames per sample of the semap profile.
-  EXPECT_EQ(frames, 3 * figure(out, "estimation       : ")) << out;
-
-  // The GNSS port's bytes, all the driver read.
-  std::ifstream gnss_file(rec() / "gnss.log", std::ios::binary);
-  semap::drivers::StreamLogReader gnss(gnss_file, "gnss.log",
-                                       semap::drivers::StreamLogKind::kBytes);
-  long long bytes = 0;
-  while (const auto chunk = gnss.next_bytes()) bytes += static_cast<long long>(chunk->bytes.size());
-  EXPECT_EQ(gnss.error(), "");
-  EXPECT_EQ(bytes, figure(out, "fixes, ")) << out;
-
-  // Camera frames, every one the perception stage took.
-  for (const char* name : {"colour.log", "depth.log"}) {
-    std::ifstream file(rec() / name, std::ios::binary);
-    semap::drivers::StreamLogReader log(file, name, semap::drivers::StreamLogKind::kFrames);
-    long long n = 0;
-    while (const auto f = log.next_frame()) {
-      EXPECT_EQ(f->width, 320u);
-      ++n;
-    }
-    EXPECT_EQ(log.error(), "");
-    EXPECT_EQ(n, figure(out, "perception       : ")) << name;
+  // The log decodes to the samples the robot had: semap-can --input, and the MCAP directly.
+  const auto from_log = run_cli(kCan, "--input " + log.string() + " --json");
+  const auto from_mcap = run_cli(kCan, "--from-mcap " + rec().string() + " --json");
+  ASSERT_EQ(from_log.status, 0) << from_log.out.substr(0, 500);
+  ASSERT_EQ(from_mcap.status, 0) << from_mcap.out.substr(0, 500);
+  long long samples = 0;
+  for (std::size_t at = from_log.out.find("{\"class\":\"IMU\""); at != std::string::npos;
+       at = from_log.out.find("{\"class\":\"IMU\"", at + 1)) {
+    ++samples;
   }
-  EXPECT_EQ(slurp(rec() / "config.yaml"), slurp(*dir_ / "live.yaml"));
+  EXPECT_EQ(samples, figure(live_->out, "estimation       : ")) << from_log.out.substr(0, 500);
+  EXPECT_EQ(from_log.out, from_mcap.out);
 }
 
 // Each cell of a .smap by its global cell coordinates: its evidence per channel.
@@ -287,41 +347,85 @@ TEST_F(RecordReplay, AtRecordedPaceTheGnssGoesThroughAPty) {
   EXPECT_GE(shared, 0.9);
 }
 
-TEST_F(RecordReplay, ADamagedRecordingPlaysUpToTheDamage) {
-  const fs::path damaged = *dir_ / "damaged";
-  fs::copy(rec(), damaged);
-  // The colour log cut in the middle of a late frame (a crash mid-write).
-  const auto colour = damaged / "colour.log";
-  fs::resize_file(colour, fs::file_size(colour) * 9 / 10);
-  const auto r = run_cli(kOnboard, "--replay " + damaged.string() + " --pace fast --save " +
-                                       (*dir_ / "damaged.smap").string());
+TEST_F(RecordReplay, ARecordingCutOffPlaysUpToItsLastWholeChunk) {
+  // The file cut off at 70 % (a crash, a power loss): no summary, the last chunk torn.
+  const fs::path cut = *dir_ / "cut.mcap";
+  fs::copy_file(rec(), cut, fs::copy_options::overwrite_existing);
+  fs::resize_file(cut, fs::file_size(cut) * 7 / 10);
+  const auto r = run_cli(kOnboard, "--replay " + cut.string() + " --pace fast --save " +
+                                       (*dir_ / "cut.smap").string() + " --trajectory " +
+                                       (*dir_ / "cut.csv").string());
   EXPECT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("damaged: " + colour.string() + ": record "), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find(": data: truncated"), std::string::npos) << r.out;
-  // The other streams go on to their ends.
-  EXPECT_EQ(figure(r.out, "estimation       : "), figure(live_->out, "estimation       : "));
-  EXPECT_EQ(figure(r.out, "GNSS fixes ("), figure(live_->out, "GNSS fixes ("));
-  const long long colour_frames = figure(r.out, "GNSS reads, ");
+  const std::string replayed = line_of(r.out, "replay           : ");
+  EXPECT_NE(replayed.find("damaged: " + cut.string() + ": truncated at byte "), std::string::npos)
+      << r.out;
+  // Every stream up to the cut: fewer samples and frames, the same ones as far as they go.
+  const long long samples = figure(r.out, "estimation       : ");
+  EXPECT_GT(samples, 1000);
+  EXPECT_LT(samples, figure(live_->out, "estimation       : "));
+  const long long colour_frames = figure(replayed, "GNSS reads, ");
   EXPECT_GT(colour_frames, 0);
   EXPECT_LT(colour_frames,
             figure(line_of(live_->out, "perception       : "), "perception       : "));
+  const auto live = read_trajectory(*dir_ / "live.csv");
+  const auto d = differences(live, read_trajectory(*dir_ / "cut.csv"));
+  ASSERT_GT(d.size(), 1000u);
+  EXPECT_LE(d.back(), 1e-3);
 
-  // A line of the CAN log that is not candump -L: named by file and line.
-  fs::copy(rec() / "colour.log", colour, fs::copy_options::overwrite_existing);
-  std::string imu = slurp(damaged / "imu.log");
-  const auto line_1000 = [&] {
-    std::size_t at = 0;
-    for (int i = 0; i < 999; ++i) at = imu.find('\n', at) + 1;
-    return at;
-  }();
-  imu.insert(line_1000, "(12.500000) sim 123#XYZ\n");
-  std::ofstream(damaged / "imu.log") << imu;
-  const auto bad = run_cli(kOnboard, "--replay " + damaged.string() + " --pace fast --save " +
-                                         (*dir_ / "damaged.smap").string());
-  // The 999 frames before the bad line: 333 samples of 3 frames each.
-  EXPECT_EQ(figure(line_of(bad.out, "replay           : "), "error frames), "), 333) << bad.out;
-  EXPECT_NE(bad.out.find((damaged / "imu.log").string() + ":1000: data"), std::string::npos)
-      << bad.out;
+  // Cut inside the first chunk: nothing to play, said so.
+  fs::resize_file(cut, 4096);
+  const auto nothing = run_cli(kOnboard, "--config " + (*dir_ / "live.yaml").string() +
+                                             " --replay " + cut.string() + " --pace fast");
+  EXPECT_NE(nothing.status, 0);
+  EXPECT_NE(nothing.out.find("truncated at byte"), std::string::npos) << nothing.out;
+}
+
+// The recording of the older format (a directory: candump log, stream logs, config) still
+// replays, for one release: the MCAP recording's inputs written in that format give the same
+// trajectory.
+TEST_F(RecordReplay, TheOlderDirectoryFormatStillReplays) {
+  const fs::path dir = *dir_ / "rec-dir";
+  fs::create_directories(dir);
+  {
+    std::ofstream imu(dir / "imu.log");
+    semap::drivers::StreamLogWriter gnss(dir / "gnss.log", semap::drivers::StreamLogKind::kBytes);
+    semap::drivers::StreamLogWriter colour(dir / "colour.log",
+                                           semap::drivers::StreamLogKind::kFrames);
+    semap::drivers::StreamLogWriter depth(dir / "depth.log",
+                                          semap::drivers::StreamLogKind::kFrames);
+    semap::onboard::McapRecordingReader reader(rec());
+    while (!reader.ended() || !reader.can.empty() || !reader.gnss.empty() ||
+           !reader.colour.empty() || !reader.depth.empty()) {
+      reader.fill();
+      for (const auto& c : reader.can) {
+        SemapCandumpRecord r{};
+        r.seconds = static_cast<std::uint64_t>(c.stamp.ns / 1'000'000'000);
+        r.microseconds = static_cast<std::uint32_t>((c.stamp.ns % 1'000'000'000) / 1'000);
+        std::strcpy(r.interface, "sim");
+        r.kind = c.error_frame ? SEMAP_CANDUMP_ERROR : SEMAP_CANDUMP_DATA;
+        r.frame = c.frame;
+        imu << semap::firmware_bridge::format_candump_line(r);
+      }
+      for (const auto& g : reader.gnss) gnss.write_bytes(g.stamp, g.bytes);
+      for (const auto& f : reader.colour) colour.write_frame(f);
+      for (const auto& f : reader.depth) depth.write_frame(f);
+      reader.can.clear();
+      reader.gnss.clear();
+      reader.colour.clear();
+      reader.depth.clear();
+    }
+    ASSERT_EQ(reader.error(), "");
+  }
+  fs::copy_file(*dir_ / "live.yaml", dir / "config.yaml");
+  const auto r = run_cli(kOnboard, "--replay " + dir.string() + " --pace fast --save " +
+                                       (*dir_ / "dir.smap").string() + " --trajectory " +
+                                       (*dir_ / "dir.csv").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(figure(r.out, "estimation       : "), figure(live_->out, "estimation       : "));
+  const auto live = read_trajectory(*dir_ / "live.csv");
+  const auto d = differences(live, read_trajectory(*dir_ / "dir.csv"));
+  ASSERT_EQ(d.size(), live.size());
+  EXPECT_LE(d.back(), 1e-3);
 }
 
 // The definitions the fast paths are tested against, selected by configuration, on the recorded
@@ -329,7 +433,7 @@ TEST_F(RecordReplay, ADamagedRecordingPlaysUpToTheDamage) {
 // propagation (estimator.covariance_window: 1), against the defaults (tiled engine, 32-step
 // window), both replayed as fast as possible.
 TEST_F(RecordReplay, ThePlainMathsGiveTheDefaultsRun) {
-  std::string config = slurp(rec() / "config.yaml");
+  std::string config = slurp(*dir_ / "live.yaml");  // the configuration the recording holds
   replace(config, "engine: tiled", "engine: plain");
   replace(config, "covariance_window: 32", "covariance_window: 1");
   std::ofstream(*dir_ / "plain.yaml") << config;

@@ -35,7 +35,8 @@ enum class ReplayPace : std::uint8_t { kRecorded, kFast };
 // that has that rig (see load_onboard_config).
 struct RigConfig {
   RigKind kind = RigKind::kSim;
-  std::filesystem::path replay;  // rig.replay: the directory semap-onboard --record wrote
+  std::filesystem::path
+      replay;  // rig.replay: the MCAP file semap-onboard --record wrote (or an older DIR)
   ReplayPace pace = ReplayPace::kRecorded;
   double duration_s = 40.0;  // 0: run until SIGINT (a replay ends with its recording)
 };

@@ -19,6 +19,7 @@
 #include "semap/onboard/run_figures.hpp"
 #include "semap/onboard/sensor_rig.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
+#include "semap/onboard/tap_fanout.hpp"
 
 namespace semap::onboard {
 
@@ -70,10 +71,14 @@ class Pipeline {
   // Before start().
   void attach(PipelineObserver& observer) { observers_.push_back(&observer); }
   // Before start(): every message the DDS outputs write also goes to `tap` (the viewer, a
-  // recorder). False when there are no DDS outputs (dds.enabled: false).
+  // recorder; each tap gets them all, through one fan-out). False when there are no DDS
+  // outputs (dds.enabled: false).
   bool attach_tap(dds_idl::MessageTap& tap) {
-    if (dds_) dds_->attach_tap(tap);
-    return dds_ != nullptr;
+    if (!dds_) return false;
+    const bool first = taps_.empty();
+    taps_.add(tap);
+    if (first) dds_->attach_tap(taps_);
+    return true;
   }
   SensorRig& rig() { return *rig_; }
   const SensorRig& rig() const { return *rig_; }
@@ -136,6 +141,7 @@ class Pipeline {
   std::unique_ptr<SensorRig> rig_;
   std::vector<PipelineObserver*> observers_;
   std::filesystem::path checkpoint_path_;
+  TapFanout taps_;  // the DDS outputs' taps (attach_tap); outlives their writers
   // Declared in the order they may be destroyed last: the publisher reads the mapping stage.
   std::unique_ptr<MappingStage> mapping_;
   std::unique_ptr<DdsOutputs> dds_;

@@ -16,11 +16,22 @@
 #include "semap/firmware_bridge/can_imu_decoder.hpp"
 #include "semap/firmware_bridge/candump_reader.hpp"
 #include "semap/firmware_bridge/gnss_stream_decoder.hpp"
+#include "semap/onboard/mcap_recording.hpp"
 #include "semap/onboard/onboard_config.hpp"
 #include "semap/onboard/pseudo_terminal.hpp"
 #include "semap/onboard/sensor_rig.hpp"
 
 namespace semap::onboard {
+
+// The files of a recording in the directory format of semap before MCAP (replayed for one
+// more release; semap-onboard --record writes MCAP files only).
+struct RecordingFiles {
+  static constexpr const char* kImu = "imu.log";        // candump -L
+  static constexpr const char* kGnss = "gnss.log";      // drivers::StreamLogKind::kBytes
+  static constexpr const char* kColour = "colour.log";  // drivers::StreamLogKind::kFrames
+  static constexpr const char* kDepth = "depth.log";    // drivers::StreamLogKind::kFrames
+  static constexpr const char* kConfig = "config.yaml";
+};
 
 // What a replay has handed to the pipeline so far.
 struct ReplayCounters {
@@ -33,7 +44,8 @@ struct ReplayCounters {
   std::uint64_t depth_frames = 0;
 };
 
-// rig.kind: replay. Plays a recording made with `semap-onboard --record` back through the
+// rig.kind: replay. Plays a recording made with `semap-onboard --record` (an MCAP file, or a
+// directory of the format before it) back through the
 // pipeline's own decoders, all streams merged in stamp order: the IMU's CAN frames through the
 // CAN IMU decoder of the configured profile into the IMU ring, the GNSS bytes into a pty read by
 // the real GnssDriver (recorded pace) or, as fast as possible, through the GNSS stream decoder
@@ -50,7 +62,7 @@ class ReplayRig final : public SensorRig {
   ReplayRig& operator=(const ReplayRig&) = delete;
 
   std::string describe() const override { return "on a replay of " + dir_.string(); }
-  bool has_camera() const override { return colour_ != nullptr; }
+  bool has_camera() const override { return colour_ != nullptr || mcap_camera_; }
   // Pipeline stamp minus recorded stamp.
   std::int64_t stamp_offset_ns() const override { return offset_ns_; }
   // A replay is not recorded again: throws.
@@ -77,10 +89,12 @@ class ReplayRig final : public SensorRig {
   void advance_imu();
   void advance_gnss();
   static void advance(FrameStream& stream);
-  void play_imu(common::Stamp stamp, std::stop_token stop);
-  void play_gnss(common::Stamp stamp, std::stop_token stop);
-  void play_frame(FrameStream& stream, common::SpscRing<common::ImageFrame>& ring, bool colour,
+  void play_can(const SemapCanFrame& frame, bool error_frame, common::Stamp stamp,
+                std::stop_token stop);
+  void play_gnss(const std::vector<std::uint8_t>& bytes, common::Stamp stamp, std::stop_token stop);
+  void play_frame(common::ImageFrame frame, common::SpscRing<common::ImageFrame>& ring, bool colour,
                   std::stop_token stop);
+  void open_directory(const OnboardConfig& config);
   template <typename T>
   void push(common::SpscRing<T>& ring, T value, std::stop_token stop);
   void wait_settled(std::stop_token stop);
@@ -108,6 +122,9 @@ class ReplayRig final : public SensorRig {
 
   std::unique_ptr<FrameStream> colour_;
   std::unique_ptr<FrameStream> depth_;
+  // An MCAP recording (instead of the directory's readers above).
+  std::unique_ptr<McapRecordingReader> mcap_;
+  bool mcap_camera_ = false;
 
   std::int64_t offset_ns_ = 0;
   Taken taken_;
