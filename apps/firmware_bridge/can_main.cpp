@@ -1,7 +1,8 @@
 // semap-can: decodes an IMU's CAN frames like the robot does (semap protocol or J1939, as the
 // onboard config's imu: section or the flags say), from a live interface or a `candump -L`
-// log, into one line or JSON object per sample, then every counter. Records a live interface
-// as a candump -L log that can-utils' canplayer replays.
+// log or an MCAP recording of semap-onboard (its can_msgs/msg/Frame channel), into one line or
+// JSON object per sample, then every counter. Records a live interface as a candump -L log that
+// can-utils' canplayer replays, and extracts an MCAP recording's CAN frames as one.
 #include <linux/can.h>
 
 #include <CLI/CLI.hpp>
@@ -11,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -19,9 +21,12 @@
 
 #include "semap/common/config.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/dds_idl/message_tap.hpp"
+#include "semap/dds_idl/recording_types.hpp"
 #include "semap/drivers/can_bus_state.hpp"
 #include "semap/drivers/can_socket.hpp"
 #include "semap/drivers/driver_config.hpp"
+#include "semap/drivers/mcap_message_reader.hpp"
 #include "semap/firmware_bridge/can_imu_decoder.hpp"
 #include "semap/firmware_bridge/candump_reader.hpp"
 
@@ -154,6 +159,8 @@ class LogRecorder {
 struct Options {
   std::string interface;
   std::string input;
+  std::string from_mcap;
+  std::string candump;
   std::string channel;
   std::string config;
   std::string profile;
@@ -204,7 +211,16 @@ int run(int argc, char** argv) {
   auto* interface_opt =
       app.add_option("--interface", o.interface, "live CAN interface (can0, vcan0)")
           ->excludes(input_opt);
+  auto* mcap_opt = app.add_option("--from-mcap", o.from_mcap,
+                                  "an MCAP recording of semap-onboard --record: its CAN frames "
+                                  "(/semap/raw/can, can_msgs/msg/Frame)")
+                       ->check(CLI::ExistingFile)
+                       ->excludes(input_opt)
+                       ->excludes(interface_opt);
   input_opt->excludes(interface_opt);
+  app.add_option("--candump", o.candump,
+                 "with --from-mcap: write its CAN frames as a candump -L log for can-utils")
+      ->needs(mcap_opt);
   app.add_option("--channel", o.channel, "with --input: only records of this interface")
       ->needs(input_opt);
   app.add_option("--config", o.config, "onboard YAML: the IMU profile from its imu: section")
@@ -222,8 +238,8 @@ int run(int argc, char** argv) {
   app.add_option("--log-level", log_level, "trace..off");
   CLI11_PARSE(app, argc, argv);
   semap::common::setup_logging(log_level);
-  if (o.input.empty() && o.interface.empty()) {
-    std::fprintf(stderr, "semap-can: give --input LOG or --interface IF\n");
+  if (o.input.empty() && o.interface.empty() && o.from_mcap.empty()) {
+    std::fprintf(stderr, "semap-can: give --input LOG, --from-mcap FILE.mcap or --interface IF\n");
     return 2;
   }
 
@@ -242,7 +258,65 @@ int run(int argc, char** argv) {
   try {
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    if (!o.input.empty()) {
+    if (!o.from_mcap.empty()) {
+      // Stamps are the recording's (CLOCK_MONOTONIC, as the robot's), kept in the candump log.
+      namespace dds = semap::dds_idl;
+      semap::drivers::mcap::McapMessageReader reader{std::filesystem::path(o.from_mcap)};
+      std::unique_ptr<std::FILE, int (*)(std::FILE*)> log(nullptr, &std::fclose);
+      if (!o.candump.empty()) {
+        log.reset(std::fopen(o.candump.c_str(), "w"));
+        if (!log) throw std::runtime_error("--candump " + o.candump + ": cannot create");
+      }
+      while (!g_stop) {
+        const auto m = reader.next();
+        if (!m) break;
+        if (m->channel.topic != dds::RecordingTopics::kCan) continue;
+        dds::msg::CanFrame f{};
+        if (!dds::deserialize_cdr(m->message.data, f) || f.dlc_ > SEMAP_CAN_MAX_DLEN) {
+          throw std::runtime_error(o.from_mcap + ": a " + dds::RecordingTopics::kCan +
+                                   " message does not decode as can_msgs/msg/Frame");
+        }
+        SemapCandumpRecord r{};
+        r.seconds =
+            f.header_.stamp_.sec_ < 0 ? 0 : static_cast<std::uint64_t>(f.header_.stamp_.sec_);
+        r.microseconds = f.header_.stamp_.nanosec_ / 1000;
+        const std::string interface = f.header_.frame_id_ != nullptr ? f.header_.frame_id_ : "";
+        std::snprintf(r.interface, sizeof(r.interface), "%s",
+                      interface.empty() ? "can0" : interface.c_str());
+        r.kind = f.is_error_ ? SEMAP_CANDUMP_ERROR
+                 : f.is_rtr_ ? SEMAP_CANDUMP_REMOTE
+                             : SEMAP_CANDUMP_DATA;
+        r.frame.id = f.id_;
+        r.frame.extended = f.is_extended_ ? 1 : 0;
+        r.frame.len = f.dlc_;
+        std::memcpy(r.frame.data, f.data_, 8);
+        dds_sample_free(&f, dds::TypeDescriptor<dds::msg::CanFrame>::get(), DDS_FREE_CONTENTS);
+        if (log) {
+          const std::string line = fb::format_candump_line(r);
+          if (std::fputs(line.c_str(), log.get()) < 0) {
+            throw std::runtime_error("--candump " + o.candump + ": write failed");
+          }
+        }
+        ++in.records;
+        if (!o.channel.empty() && o.channel != r.interface) {
+          ++in.other_channel;
+        } else if (r.kind == SEMAP_CANDUMP_REMOTE) {
+          ++in.remote;
+        } else if (r.kind == SEMAP_CANDUMP_ERROR) {
+          handle_error_frame(r.frame, realtime_stamp(r), o.json, in);
+        } else if (push(r.frame, realtime_stamp(r))) {
+          break;
+        }
+      }
+      if (log && std::fclose(log.release()) != 0) {
+        throw std::runtime_error("--candump " + o.candump + ": write failed");
+      }
+      if (reader.status() != semap::drivers::mcap::McapReadStatus::kEnd && !g_stop &&
+          !(o.count > 0 && printed >= o.count)) {
+        // A recording cut off (a crash): its frames up to the last whole chunk are out.
+        std::fprintf(stderr, "semap-can: %s\n", reader.error().c_str());
+      }
+    } else if (!o.input.empty()) {
       std::ifstream file(o.input, std::ios::binary);
       if (!file) throw std::runtime_error("--input " + o.input + ": cannot open");
       fb::CandumpReader reader(file, o.input);
