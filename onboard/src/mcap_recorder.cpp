@@ -1,5 +1,6 @@
 #include "semap/onboard/mcap_recorder.hpp"
 
+#include <pthread.h>
 #include <spdlog/fmt/fmt.h>
 
 #include <algorithm>
@@ -84,7 +85,8 @@ void McapRecorder::attach(Pipeline& pipeline) {
 bool McapRecorder::enqueue(Item&& item, std::size_t size) {
   {
     std::lock_guard lock(queue_mutex_);
-    if (closing_ || queued_bytes_ + size > options_.queue_bytes) {
+    if (closing_) return false;  // after the run: the file is closed
+    if (queued_bytes_ + size > options_.queue_bytes) {
       ++dropped_;
       return false;
     }
@@ -121,7 +123,8 @@ void McapRecorder::on_frame(const common::ImageFrame& frame, bool depth) {
   {
     // Not even the copy when it would not fit.
     std::lock_guard lock(queue_mutex_);
-    if (closing_ || queued_bytes_ + frame.data.size() + kItemOverhead > options_.queue_bytes) {
+    if (closing_) return;
+    if (queued_bytes_ + frame.data.size() + kItemOverhead > options_.queue_bytes) {
       ++dropped_;
       return;
     }
@@ -289,6 +292,7 @@ void McapRecorder::write_item(Item& item) {
 }
 
 void McapRecorder::run(std::stop_token stop) {
+  pthread_setname_np(pthread_self(), "recorder");  // its CPU in top -H, bench/recording
   std::deque<Item> batch;
   auto last_message = std::chrono::steady_clock::now();
   bool unflushed = false;
