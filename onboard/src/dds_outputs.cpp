@@ -19,6 +19,10 @@ DdsOutputs::DdsOutputs(const DdsConfig& config, const dds_idl::MapDescription& m
       odometry_writer_(
           participant_, odometry_topic_,
           dds_idl::topic_qos(dds_idl::SemapTopic::kOdometry, config.sensor_reliability)),
+      gnss_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kGnss),
+                  dds_idl::topic_qos(dds_idl::SemapTopic::kGnss, config.sensor_reliability)),
+      gnss_writer_(participant_, gnss_topic_,
+                   dds_idl::topic_qos(dds_idl::SemapTopic::kGnss, config.sensor_reliability)),
       tf_topic_(participant_, dds_idl::topic_name(config.ns, dds_idl::SemapTopic::kTf),
                 dds_idl::topic_qos(dds_idl::SemapTopic::kTf)),
       tf_writer_(participant_, tf_topic_, dds_idl::topic_qos(dds_idl::SemapTopic::kTf)),
@@ -57,6 +61,7 @@ void DdsOutputs::write_tf_static() {
 
 void DdsOutputs::attach_tap(dds_idl::MessageTap& tap) {
   odometry_writer_.attach_tap(tap);
+  gnss_writer_.attach_tap(tap);
   tf_writer_.attach_tap(tap);
   tf_static_writer_.attach_tap(tap);
   health_writer_.attach_tap(tap);
@@ -128,6 +133,12 @@ void DdsOutputs::run_publisher(std::stop_token stop) {
     update_counters();
     std::this_thread::sleep_for(kTick);
   }
+}
+
+void DdsOutputs::publish_fix(const common::GnssFix& fix) {
+  dds_idl::msg::NavSatFix m;
+  dds_idl::to_msg(fix, "gnss", m);
+  gnss_writer_.write(m);
 }
 
 void DdsOutputs::publish_pose(const PoseOutput& pose) {

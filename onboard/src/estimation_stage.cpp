@@ -14,12 +14,13 @@ namespace semap::onboard {
 EstimationStage::EstimationStage(const EstimationStageConfig& config,
                                  common::SpscRing<common::ImuSample>& imu,
                                  common::SpscRing<common::GnssFix>& gnss, SharedPoseHistory& poses,
-                                 PoseSink pose_sink)
+                                 PoseSink pose_sink, FixSink fix_sink)
     : config_(config),
       imu_ring_(imu),
       gnss_ring_(gnss),
       poses_(poses),
       pose_sink_(std::move(pose_sink)),
+      fix_sink_(std::move(fix_sink)),
       estimator_(config.estimator) {
   if (!config.trajectory.empty()) {
     trajectory_ = std::make_unique<TrajectoryLog>(config.trajectory, config.trajectory_offset_ns);
@@ -57,7 +58,10 @@ bool EstimationStage::drain_sensors() {
   std::array<common::GnssFix, 8> gnss_batch;
   const std::size_t n_imu = imu_ring_.try_pop_batch(imu_batch);
   const std::size_t n_gnss = gnss_ring_.try_pop_batch(gnss_batch);
-  for (std::size_t g = 0; g < n_gnss; ++g) estimator_.add_gnss(gnss_batch[g]);
+  for (std::size_t g = 0; g < n_gnss; ++g) {
+    if (fix_sink_) fix_sink_(gnss_batch[g]);
+    estimator_.add_gnss(gnss_batch[g]);
+  }
   stage_.figures().gnss_fixes += n_gnss;
   for (std::size_t i = 0; i < n_imu; ++i) {
     last_imu_ = imu_batch[i];

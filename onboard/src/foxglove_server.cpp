@@ -1,5 +1,6 @@
 #include "semap/onboard/foxglove_server.hpp"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <boost/asio.hpp>
@@ -440,6 +441,12 @@ void FoxgloveServer::Impl::do_accept() {
               });
         }
       };
+      // The kernel's send buffer is part of the budget: left to autotune it holds megabytes for
+      // a stalled client before the server sees it behind.
+      const std::size_t send_buffer =
+          std::clamp<std::size_t>(options_.client_budget_bytes, 64u << 10, 4u << 20);
+      beast::error_code ignored;
+      s.set_option(asio::socket_base::send_buffer_size(static_cast<int>(send_buffer)), ignored);
       std::make_shared<Reader>(*this, std::move(s))->run();
     }
     do_accept();

@@ -110,11 +110,15 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
               estimation.estimator.anchor->latitude_deg, estimation.estimator.anchor->longitude_deg,
               estimation.estimator.anchor->altitude_m);
   }
-  estimation_ = std::make_unique<EstimationStage>(estimation, imu_ring_, gnss_ring_, poses_,
-                                                  [this](const PoseOutput& pose) {
-                                                    if (dds_) dds_->publish_pose(pose);
-                                                    for (auto* o : observers_) o->on_pose(pose);
-                                                  });
+  estimation_ = std::make_unique<EstimationStage>(
+      estimation, imu_ring_, gnss_ring_, poses_,
+      [this](const PoseOutput& pose) {
+        if (dds_) dds_->publish_pose(pose);
+        for (auto* o : observers_) o->on_pose(pose);
+      },
+      [this](const common::GnssFix& fix) {
+        if (dds_) dds_->publish_fix(fix);
+      });
 }
 
 Pipeline::~Pipeline() { stop(); }

@@ -174,13 +174,20 @@ void Viewer::summary(std::vector<std::string>& lines) const {
 std::unique_ptr<Viewer> start_viewer(Pipeline& pipeline, const OnboardConfig& config) {
   if (!config.viewer.enabled) return nullptr;
   auto viewer = std::make_unique<Viewer>(config.viewer, config.map.palette, config.dds.ns);
+  // The viewer only watches: a port another program holds (a second robot on this computer)
+  // leaves the robot running without it.
+  try {
+    viewer->start();
+  } catch (const std::exception& e) {
+    common::logger("viewer")->error("{}; the robot runs without the viewer", e.what());
+    return nullptr;
+  }
   pipeline.attach(*viewer);
   if (!pipeline.attach_tap(viewer->server())) {
     common::logger("viewer")->warn(
         "viewer: dds.enabled is false: only the camera images are served (the other channels "
         "are the DDS outputs' messages)");
   }
-  viewer->start();
   return viewer;
 }
 

@@ -23,9 +23,9 @@ const out = a.out || '.';
 const [costmapW, costmapH] = (a.costmap || '0x0').split('x').map(Number);
 const costmapRes = Number(a['costmap-resolution'] || 0);
 
-// What must arrive, by topic suffix (the robot publishes no GNSS fix or pose topic over DDS;
-// a channel advertised beyond these is subscribed and decoded too).
-const REQUIRED = ['/semap/odometry', '/tf', '/tf_static', '/semap/costmap',
+// What must arrive, by topic suffix (a channel advertised beyond these is subscribed and
+// decoded too).
+const REQUIRED = ['/semap/odometry', '/semap/gnss', '/tf', '/tf_static', '/semap/costmap',
   '/semap/map_cloud', '/semap/map_cloud_updates', '/semap/map_info', '/semap/health',
   '/semap/camera/image/compressed', '/semap/segmentation/overlay/compressed'];
 const LOCAL_NS_ROS = () => BigInt(Math.round((performance.timeOrigin + performance.now()) * 1e6));
@@ -96,6 +96,10 @@ async function main() {
       const mono = Number(ros - rosToMono) / 1e9;
       odometry.push(mono.toFixed(6) + ',' + p.x + ',' + p.y + ',' + p.z);
       if (stalled && t > stalled.at + 2) odomDuringStall++;
+    } else if (topicIs(topic, '/semap/gnss')) {
+      check(Math.abs(msg.latitude) <= 90 && Math.abs(msg.longitude) <= 180 && msg.status.status >= 0,
+        'gnss fix out of range: ' + msg.latitude + ', ' + msg.longitude + ' status ' + msg.status.status);
+      check(msg.header.frame_id === 'gnss', 'gnss frame_id "' + msg.header.frame_id + '"');
     } else if (topicIs(topic, '/semap/health')) {
       health.push({ t, msg });
       // The baseline starts once perception and mapping run (the filter's heading settles first).

@@ -48,6 +48,9 @@ class DdsOutputs {
   void stop();
 
   void publish_pose(const PoseOutput& pose);
+  // Each GNSS fix the estimation stage takes, as sensor_msgs/NavSatFix in the frame "gnss" (the
+  // estimation thread).
+  void publish_fix(const common::GnssFix& fix);
   // From the mapping thread: these blocks changed, those were paged out to the checkpoint log
   // (cheap, never waits for DDS). A paged-out block leaves the block writer's history once it
   // went out: memory stays bounded by map.memory_radius_m, and a late joiner gets the blocks
@@ -56,7 +59,7 @@ class DdsOutputs {
                       const std::vector<common::BlockIndex>& paged_out = {});
   // From the main thread, at 1 Hz.
   void publish_health(const dds_idl::HealthReport& report);
-  // Every message written from now on also goes to `tap` as the CDR DDS sends (odometry, tf,
+  // Every message written from now on also goes to `tap` as the CDR DDS sends (odometry, gnss, tf,
   // tf_static (written again for it), health, map_info, map_cloud and its updates, the
   // costmap and its updates). Before start(), from the thread that calls start().
   void attach_tap(dds_idl::MessageTap& tap);
@@ -77,6 +80,8 @@ class DdsOutputs {
   dds_idl::Topic<dds_idl::msg::Odometry> odometry_topic_;
   dds_idl::Writer<dds_idl::msg::Odometry> odometry_writer_;
   std::atomic<std::uint64_t> odometry_written_{0};
+  dds_idl::Topic<dds_idl::msg::NavSatFix> gnss_topic_;
+  dds_idl::Writer<dds_idl::msg::NavSatFix> gnss_writer_;
   dds_idl::Topic<dds_idl::msg::TFMessage> tf_topic_;
   dds_idl::Writer<dds_idl::msg::TFMessage> tf_writer_;
   dds_idl::Topic<dds_idl::msg::TFMessage> tf_static_topic_;

@@ -60,10 +60,12 @@ struct EstimationStageConfig {
 class EstimationStage {
  public:
   using PoseSink = std::function<void(const PoseOutput&)>;
+  using FixSink = std::function<void(const common::GnssFix&)>;
 
+  // `fix_sink` gets each GNSS fix as the stage takes it (its thread), before the filter does.
   EstimationStage(const EstimationStageConfig& config, common::SpscRing<common::ImuSample>& imu,
                   common::SpscRing<common::GnssFix>& gnss, SharedPoseHistory& poses,
-                  PoseSink pose_sink);
+                  PoseSink pose_sink, FixSink fix_sink = {});
   ~EstimationStage();
   EstimationStage(const EstimationStage&) = delete;
   EstimationStage& operator=(const EstimationStage&) = delete;
@@ -88,6 +90,7 @@ class EstimationStage {
   common::SpscRing<common::GnssFix>& gnss_ring_;
   SharedPoseHistory& poses_;
   PoseSink pose_sink_;
+  FixSink fix_sink_;
   estimation::Estimator estimator_;
   std::vector<estimation::StampedPose> new_poses_;
   std::unique_ptr<TrajectoryLog> trajectory_;

@@ -23,8 +23,10 @@ namespace semap::onboard {
 //
 // Each client has a byte budget: while more than `client_budget_bytes` wait to be sent to it,
 // messages of droppable channels are dropped for that client (counted), and the newest message
-// of each latched channel is kept and sent once the client catches up. A client subscribing to
-// a latched channel gets its newest message at once.
+// of each latched channel is kept and sent once the client catches up. The kernel's send
+// buffer of each client's socket is set to the budget too (64 KiB to 4 MiB), so a stalled client
+// holds at most about twice the budget on the robot. A client subscribing to a latched channel
+// gets its newest message at once.
 class FoxgloveServer : public dds_idl::MessageTap {
  public:
   struct Options {

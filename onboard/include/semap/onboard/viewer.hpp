@@ -77,8 +77,9 @@ class Viewer : public PipelineObserver {
   std::jthread thread_;
 };
 
-// With viewer.enabled: a Viewer attached to `pipeline` (observer and DDS tap) and started;
-// otherwise null. Before pipeline.start().
+// With viewer.enabled: a Viewer started and attached to `pipeline` (observer and DDS tap);
+// otherwise null, and null (the error logged) when it cannot listen on viewer.address:port.
+// Before pipeline.start().
 std::unique_ptr<Viewer> start_viewer(Pipeline& pipeline, const OnboardConfig& config);
 
 }  // namespace semap::onboard
