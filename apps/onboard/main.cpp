@@ -40,7 +40,7 @@ void on_signal(int) { g_stop.store(true); }
 struct RunOptions {
   std::string config_path;
   std::string record_file;
-  std::string record_compression = "zstd";
+  std::string record_compression = "lz4";
   std::string report_dir;
   std::string trajectory;
 };
@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
                  "record the raw sensor streams and the outputs into this new MCAP file "
                  "(docs/record-replay.md)");
   app.add_option("--record-compression", options.record_compression,
-                 "the recording's chunk compression: zstd (default) | lz4 | none")
+                 "the recording's chunk compression: lz4 (default) | zstd | none")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}));
   app.add_option("--replay", replay_dir,
                  "play back a recording made with --record (rig.kind: replay, rig.replay: "
