@@ -1,6 +1,6 @@
 // MCAP write speed per compression on a 10 MB mixed set: every 20th message camera-sized
-// (60 kB of depth-like pixels), the rest IMU/CAN-sized. Figures: bytes/s of message payload and
-// the file's size against the payload (counter "file_ratio").
+// (60 kB of depth-image-like pixels, as the MCAP tests write), the rest IMU/CAN-sized. Figures:
+// bytes/s of message payload and the file's size against the payload (counter "file_ratio").
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "mcap_test_recording.hpp"  // its depth-image-like payload
 #include "semap/drivers/mcap_writer.hpp"
 
 namespace {
@@ -17,26 +18,12 @@ namespace fs = std::filesystem;
 namespace mcap = semap::drivers::mcap;
 using Bytes = std::vector<std::uint8_t>;
 
-// 16-bit little-endian pixels rising along each 320-pixel row with two bits of noise: compresses
-// like a depth image.
-Bytes depth_like(std::size_t size, std::uint32_t seed) {
-  Bytes out(size);
-  std::uint32_t x = seed * 2654435761u + 1;
-  for (std::size_t i = 0; i + 1 < size; i += 2) {
-    x = x * 1664525u + 1013904223u;
-    const auto pixel = static_cast<std::uint16_t>(1000 + (i / 2) % 320 / 2 + (x >> 30));
-    out[i] = static_cast<std::uint8_t>(pixel);
-    out[i + 1] = static_cast<std::uint8_t>(pixel >> 8);
-  }
-  return out;
-}
-
 void BM_McapWrite(benchmark::State& state) {
   const auto compression = static_cast<mcap::Compression>(state.range(0));
   std::vector<Bytes> set;
   std::size_t total = 0;
   for (std::uint32_t i = 0; total < 10'000'000; ++i) {
-    set.push_back(depth_like(i % 20 == 0 ? 60'000 : 64 + i % 200, i));
+    set.push_back(mcap::test_recording::payload(i % 20 == 0 ? 60'000 : 64 + i % 200, i));
     total += set.back().size();
   }
   const fs::path path = fs::temp_directory_path() / "semap_mcap_write_bench.mcap";
