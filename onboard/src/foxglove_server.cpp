@@ -1,60 +1,31 @@
+// The Foxglove WebSocket server (foxglove_server.hpp): accepting, the HTTP requests, the channels,
+// the fan-out of messages to the clients and the public API. One client's session is
+// foxglove_client.cpp; the declarations both share are foxglove_server_impl.hpp.
 #include "semap/onboard/foxglove_server.hpp"
 
 #include <algorithm>
 #include <array>
-#include <atomic>
-#include <boost/asio.hpp>
-#include <boost/beast/core.hpp>
-#include <boost/beast/http.hpp>
-#include <boost/beast/websocket.hpp>
 #include <chrono>
 #include <condition_variable>
-#include <cstring>
-#include <deque>
-#include <map>
 #include <mutex>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <thread>
 
+#include "foxglove_server_impl.hpp"
 #include "semap/common/logging.hpp"
 #include "semap/dds_idl/ros2msg.hpp"
 
 namespace semap::onboard {
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace http = beast::http;
-namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
-using json = nlohmann::json;
-
 namespace {
 
 constexpr std::array<std::string_view, 2> kSubprotocols = {"foxglove.websocket.v1",
                                                            "foxglove.sdk.v1"};
-constexpr std::size_t kMaxChannels = 256;
 // Messages waiting for the server thread; beyond this droppable ones are dropped (the thread
 // only copies and queues, so this is reached only when it gets no CPU at all).
 constexpr std::size_t kMaxInbox = 4096;
 constexpr std::size_t kMaxRequestBytes = 64 * 1024;
-
-struct Message {
-  std::uint32_t channel = 0;
-  std::uint64_t stamp_ns = 0;  // system clock
-  std::vector<std::uint8_t> cdr;
-};
-using MessagePtr = std::shared_ptr<const Message>;
-
-struct Channel {
-  dds_idl::TapChannel info;
-  std::string schema;
-};
-
-void put_le(std::string& out, std::uint64_t v, int bytes) {
-  for (int i = 0; i < bytes; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xffu));
-}
 
 // "?a=1&token=x" -> "x" for "token" (no percent-decoding beyond '+': tokens are plain).
 std::optional<std::string> query_param(std::string_view target, std::string_view key) {
@@ -95,306 +66,11 @@ std::int64_t realtime_minus_monotonic_ns() {
 
 }  // namespace
 
-class FoxgloveServer::Impl {
- public:
-  class Client;
-
-  explicit Impl(Options options)
-      : options_(std::move(options)), offset_ns_(realtime_minus_monotonic_ns()) {
-    for (auto& s : subscribers_) s.store(0);
-    session_id_ = std::to_string(common::Stamp::now().ns);
-  }
-
-  Options options_;
-  std::int64_t offset_ns_;
-  std::string session_id_;
-  asio::io_context io_{1};
-  std::optional<tcp::acceptor> acceptor_;
-  std::thread thread_;
-  std::atomic<bool> running_{false};
-  std::uint16_t port_ = 0;
-
-  mutable std::mutex channels_mutex_;
-  std::deque<Channel> channels_;
-  std::array<std::atomic<int>, kMaxChannels> subscribers_;
-
-  std::mutex inbox_mutex_;
-  std::vector<MessagePtr> inbox_;
-  bool drain_posted_ = false;
-  std::atomic<std::uint64_t> inbox_dropped_{0};
-
-  // The server thread's: the newest message of each latched channel, and the clients.
-  std::map<std::uint32_t, MessagePtr> latest_;
-  mutable std::mutex clients_mutex_;  // guards the vector for readers on other threads
-  std::vector<std::shared_ptr<Client>> clients_;
-
-  std::atomic<std::uint64_t> accepted_{0}, refused_{0}, closed_error_{0}, http_requests_{0},
-      bad_requests_{0};
-  // Of clients gone (the connected ones add their own).
-  std::atomic<std::uint64_t> gone_bytes_{0}, gone_messages_{0}, gone_dropped_{0};
-  std::deque<dds_idl::ViewerClientData> gone_;  // under clients_mutex_, the last 64
-
-  void gone(const dds_idl::ViewerClientData& f) {
-    gone_bytes_ += f.bytes_sent;
-    gone_messages_ += f.messages_sent;
-    gone_dropped_ += f.messages_dropped;
-    gone_.push_back(f);
-    if (gone_.size() > 64) gone_.pop_front();
-  }
-
-  void do_accept();
-  void on_request(beast::tcp_stream stream, beast::flat_buffer buffer,
-                  http::request<http::string_body> request);
-  void drain();
-  void remove(const std::shared_ptr<Client>& client, bool error);
-  json advertise(const std::vector<std::uint32_t>& ids) const;
-  std::optional<Channel> channel(std::uint32_t id) const {
-    std::lock_guard lock(channels_mutex_);
-    if (id >= channels_.size()) return std::nullopt;
-    return channels_[id];
-  }
-};
-
-// One WebSocket client, used only on the server thread (its counters are read elsewhere).
-class FoxgloveServer::Impl::Client : public std::enable_shared_from_this<Client> {
- public:
-  Client(Impl& server, beast::tcp_stream&& stream, std::string address)
-      : server_(server),
-        ws_(std::move(stream)),
-        address_(std::move(address)),
-        connected_(common::Stamp::now()) {}
-
-  void accept(http::request<http::string_body> request, std::string subprotocol) {
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
-    ws_.set_option(websocket::stream_base::decorator([subprotocol](websocket::response_type& r) {
-      r.set(http::field::sec_websocket_protocol, subprotocol);
-      r.set(http::field::server, "semap-onboard");
-    }));
-    ws_.read_message_max(1u << 20);
-    ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
-      if (ec) return self->fail(ec, "accept");
-      self->on_open();
-    });
-  }
-
-  // A message of a channel this client may subscribe to (server thread).
-  void deliver(const MessagePtr& m, bool latched) {
-    const auto sub = by_channel_.find(m->channel);
-    if (sub == by_channel_.end()) return;
-    if (queued_bytes_ > server_.options_.client_budget_bytes) {
-      if (latched) {
-        pending_latched_[m->channel] = m;  // coalesced to the newest
-      } else {
-        dropped_.fetch_add(1, std::memory_order_relaxed);
-      }
-      return;
-    }
-    send_data(sub->second, *m);
-  }
-
-  void send_text(const json& j) { enqueue(std::make_shared<std::string>(j.dump()), false); }
-
-  void close() {
-    if (closing_) return;
-    closing_ = true;
-    ws_.async_close(websocket::close_code::going_away,
-                    [self = shared_from_this()](beast::error_code) {});
-  }
-
-  dds_idl::ViewerClientData figures() const {
-    return {address_, bytes_.load(std::memory_order_relaxed),
-            messages_.load(std::memory_order_relaxed), dropped_.load(std::memory_order_relaxed),
-            static_cast<float>(common::seconds_between(common::Stamp::now(), connected_))};
-  }
-
-  // Subscriptions: subscription id -> channel, and back.
-  std::map<std::uint32_t, std::uint32_t> subscriptions_;
-  std::map<std::uint32_t, std::uint32_t> by_channel_;
-
- private:
-  void on_open() {
-    open_ = true;
-    json info = {{"op", "serverInfo"},
-                 {"name", server_.options_.name},
-                 {"capabilities", json::array()},
-                 {"sessionId", server_.session_id_}};
-    json metadata = json::object();
-    for (const auto& [k, v] : server_.options_.metadata) metadata[k] = v;
-    info["metadata"] = metadata;
-    send_text(info);
-    std::vector<std::uint32_t> ids;
-    {
-      std::lock_guard lock(server_.channels_mutex_);
-      for (std::uint32_t i = 0; i < server_.channels_.size(); ++i) ids.push_back(i);
-    }
-    send_text(server_.advertise(ids));
-    read();
-  }
-
-  void read() {
-    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) return self->fail(ec, "read");
-      try {
-        if (self->ws_.got_text()) {
-          self->on_text(beast::buffers_to_string(self->in_.data()));
-        } else {
-          self->status(2, "binary client messages are not supported (no clientPublish)");
-        }
-      } catch (const std::exception& e) {
-        ++self->server_.bad_requests_;
-        self->status(2, std::string("bad request: ") + e.what());
-      }
-      self->in_.consume(self->in_.size());
-      self->read();
-    });
-  }
-
-  void status(int level, const std::string& message) {
-    if (level > 0) ++server_.bad_requests_;
-    send_text({{"op", "status"}, {"level", level}, {"message", message}});
-  }
-
-  void on_text(const std::string& text) {
-    const json j = json::parse(text);
-    const std::string op = j.at("op").get<std::string>();
-    if (op == "subscribe") {
-      for (const auto& s : j.at("subscriptions")) {
-        const auto id = s.at("id").get<std::uint32_t>();
-        const auto channel = s.at("channelId").get<std::uint32_t>();
-        const auto ch = server_.channel(channel);
-        if (!ch) {
-          status(2, "subscribe: unknown channel id " + std::to_string(channel));
-          continue;
-        }
-        if (subscriptions_.count(id) != 0) {
-          status(2, "subscribe: subscription id " + std::to_string(id) + " is in use");
-          continue;
-        }
-        if (by_channel_.count(channel) != 0) {
-          status(2, "subscribe: channel " + std::to_string(channel) + " is already subscribed");
-          continue;
-        }
-        subscriptions_[id] = channel;
-        by_channel_[channel] = id;
-        server_.subscribers_[channel].fetch_add(1);
-        // A late joiner gets the latched channel's newest message at once.
-        const auto latest = server_.latest_.find(channel);
-        if (latest != server_.latest_.end()) deliver(latest->second, true);
-      }
-    } else if (op == "unsubscribe") {
-      for (const auto& s : j.at("subscriptionIds")) {
-        const auto id = s.get<std::uint32_t>();
-        const auto it = subscriptions_.find(id);
-        if (it == subscriptions_.end()) {
-          status(1, "unsubscribe: unknown subscription id " + std::to_string(id));
-          continue;
-        }
-        server_.subscribers_[it->second].fetch_sub(1);
-        pending_latched_.erase(it->second);
-        by_channel_.erase(it->second);
-        subscriptions_.erase(it);
-      }
-    } else {
-      status(2, "unsupported op \"" + op + "\"");
-    }
-  }
-
- public:
-  void release_subscriptions() {
-    for (const auto& [id, channel] : subscriptions_) server_.subscribers_[channel].fetch_sub(1);
-    subscriptions_.clear();
-    by_channel_.clear();
-    pending_latched_.clear();
-  }
-
- private:
-  void send_data(std::uint32_t subscription, const Message& m) {
-    auto frame = std::make_shared<std::string>();
-    frame->reserve(13 + m.cdr.size());
-    frame->push_back(static_cast<char>(0x01));
-    put_le(*frame, subscription, 4);
-    put_le(*frame, m.stamp_ns, 8);
-    frame->append(reinterpret_cast<const char*>(m.cdr.data()), m.cdr.size());
-    enqueue(std::move(frame), true);
-  }
-
-  void enqueue(std::shared_ptr<std::string> frame, bool binary) {
-    if (closing_) return;
-    queued_bytes_ += frame->size();
-    queue_.push_back({std::move(frame), binary});
-    if (!writing_ && open_) write();
-  }
-
-  void write() {
-    if (queue_.empty()) {
-      writing_ = false;
-      return;
-    }
-    writing_ = true;
-    const Out& out = queue_.front();
-    ws_.binary(out.binary);
-    ws_.async_write(asio::buffer(*out.frame),
-                    [self = shared_from_this()](beast::error_code ec, std::size_t n) {
-                      if (ec) return self->fail(ec, "write");
-                      self->on_written(n);
-                    });
-  }
-
-  void on_written(std::size_t n) {
-    const Out out = std::move(queue_.front());
-    queue_.pop_front();
-    queued_bytes_ -= out.frame->size();
-    bytes_.fetch_add(n, std::memory_order_relaxed);
-    if (out.binary) messages_.fetch_add(1, std::memory_order_relaxed);
-    // Caught up: what the latched channels hold now goes out.
-    if (queued_bytes_ <= server_.options_.client_budget_bytes && !pending_latched_.empty()) {
-      auto pending = std::move(pending_latched_);
-      pending_latched_.clear();
-      for (const auto& [channel, m] : pending) {
-        const auto sub = by_channel_.find(channel);
-        if (sub != by_channel_.end()) send_data(sub->second, *m);
-      }
-    }
-    write();
-  }
-
-  void fail(beast::error_code ec, const char* what) {
-    if (failed_) return;
-    failed_ = true;
-    // A client that went away (closed, or its process ended: reset, end of stream) is a
-    // normal end; anything else (a protocol error, a timeout) closed it on an error.
-    const bool normal = ec == websocket::error::closed || ec == asio::error::operation_aborted ||
-                        ec == asio::error::eof || ec == asio::error::connection_reset ||
-                        ec == asio::error::broken_pipe || ec == http::error::end_of_stream ||
-                        closing_;
-    if (!normal) {
-      common::logger("viewer")->info("viewer: client {} closed: {} ({})", address_, ec.message(),
-                                     what);
-    }
-    server_.remove(shared_from_this(), !normal);
-  }
-
-  struct Out {
-    std::shared_ptr<std::string> frame;
-    bool binary = false;
-  };
-
-  Impl& server_;
-  websocket::stream<beast::tcp_stream> ws_;
-  beast::flat_buffer in_;
-  std::string address_;
-  common::Stamp connected_;
-  std::deque<Out> queue_;
-  std::size_t queued_bytes_ = 0;
-  std::map<std::uint32_t, MessagePtr> pending_latched_;
-  bool open_ = false;
-  bool writing_ = false;
-  bool closing_ = false;
-  bool failed_ = false;
-
- public:
-  std::atomic<std::uint64_t> bytes_{0}, messages_{0}, dropped_{0};
-};
+FoxgloveServer::Impl::Impl(Options options)
+    : options_(std::move(options)), offset_ns_(realtime_minus_monotonic_ns()) {
+  for (auto& s : subscribers_) s.store(0);
+  session_id_ = std::to_string(common::Stamp::now().ns);
+}
 
 json FoxgloveServer::Impl::advertise(const std::vector<std::uint32_t>& ids) const {
   json channels = json::array();
@@ -644,7 +320,7 @@ std::string FoxgloveServer::url() const {
 
 std::uint32_t FoxgloveServer::add_channel(const dds_idl::TapChannel& channel) {
   Impl& s = *impl_;
-  Channel c{channel, {}};
+  Impl::Channel c{channel, {}};
   try {
     c.schema = dds_idl::ros2msg_schema(channel.type);
   } catch (const std::exception& e) {
@@ -688,7 +364,7 @@ void FoxgloveServer::on_message(std::uint32_t channel, common::Stamp stamp,
     if (!latched) return;
   }
   try {
-    auto m = std::make_shared<Message>();
+    auto m = std::make_shared<Impl::Message>();
     m->channel = channel;
     m->stamp_ns = static_cast<std::uint64_t>(stamp.ns + s.offset_ns_);
     m->cdr.assign(cdr.begin(), cdr.end());
