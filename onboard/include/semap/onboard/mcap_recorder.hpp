@@ -21,7 +21,9 @@
 namespace semap::onboard {
 
 struct McapRecorderOptions {
-  drivers::mcap::McapWriterOptions writer;  // profile ros2, zstd level 1, 1 MiB / 1 s chunks
+  // Profile ros2, 1 MiB / 1 s chunks; semap-onboard sets the compression (--record-compression,
+  // lz4 by default).
+  drivers::mcap::McapWriterOptions writer;
   // Bytes waiting for the recorder thread at most (copies of frames, reads, messages); what
   // comes while the queue is full is dropped and counted, so no driver or stage ever waits.
   std::size_t queue_bytes = 64u << 20;
