@@ -136,8 +136,10 @@ void DdsOutputs::run_publisher(std::stop_token stop) {
 }
 
 void DdsOutputs::publish_fix(const common::GnssFix& fix) {
+  // The message borrows the frame id's characters until it is written.
+  static const std::string kGnssFrameId = "gnss";
   dds_idl::msg::NavSatFix m;
-  dds_idl::to_msg(fix, "gnss", m);
+  dds_idl::to_msg(fix, kGnssFrameId, m);
   gnss_writer_.write(m);
 }
 

@@ -313,7 +313,7 @@ TEST(FoxgloveServer, StalledClientLosesDroppableMessagesNotTheWritersTime) {
   ASSERT_TRUE(eventually([&] { return server.subscribed(images) && server.subscribed(map); }));
   // From here on the client reads nothing: its socket and the server's queue fill.
   const std::vector<std::uint8_t> big(512 * 1024, 0x5a);
-  const std::size_t rss_before = rss_bytes();
+  [[maybe_unused]] const std::size_t rss_before = rss_bytes();
   double slowest_ms = 0.0;
   constexpr int kMessages = 400;  // 200 MB offered
   for (int i = 0; i < kMessages; ++i) {
@@ -335,8 +335,11 @@ TEST(FoxgloveServer, StalledClientLosesDroppableMessagesNotTheWritersTime) {
   // Most images were dropped for it; what was sent fits the budget plus the socket buffers.
   EXPECT_GT(c.messages_dropped, kMessages / 2);
   EXPECT_LT(c.messages_sent + c.messages_dropped, static_cast<std::uint64_t>(kMessages) + 1);
+#if !defined(__SANITIZE_ADDRESS__)
+  // (Under ASan freed copies wait in its quarantine, up to 256 MB: RSS then says nothing.)
   const std::size_t grown = rss_bytes() > rss_before ? rss_bytes() - rss_before : 0;
   EXPECT_LT(grown, 64u << 20) << "the server holds what a stalled client does not read";
+#endif
   EXPECT_EQ(server.counters().messages_dropped, c.messages_dropped);
 
   // A second, healthy client is served meanwhile.
