@@ -14,6 +14,7 @@
 
 #include "foxglove_server_impl.hpp"
 #include "semap/common/logging.hpp"
+#include "semap/dds_idl/converters.hpp"
 #include "semap/dds_idl/ros2msg.hpp"
 
 namespace semap::onboard {
@@ -57,17 +58,9 @@ std::string_view content_type(std::string_view path) {
   return "application/octet-stream";
 }
 
-std::int64_t realtime_minus_monotonic_ns() {
-  const auto real = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                        std::chrono::system_clock::now().time_since_epoch())
-                        .count();
-  return real - common::Stamp::now().ns;
-}
-
 }  // namespace
 
-FoxgloveServer::Impl::Impl(Options options)
-    : options_(std::move(options)), offset_ns_(realtime_minus_monotonic_ns()) {
+FoxgloveServer::Impl::Impl(Options options) : options_(std::move(options)) {
   for (auto& s : subscribers_) s.store(0);
   session_id_ = std::to_string(common::Stamp::now().ns);
 }
@@ -366,7 +359,10 @@ void FoxgloveServer::on_message(std::uint32_t channel, common::Stamp stamp,
   try {
     auto m = std::make_shared<Impl::Message>();
     m->channel = channel;
-    m->stamp_ns = static_cast<std::uint64_t>(stamp.ns + s.offset_ns_);
+    // The time the headers carry (ROS time by default, dds.stamp_clock), so Foxglove's timeline
+    // and the messages agree, also across a step of the wall clock.
+    const dds_idl::msg::Time time = dds_idl::to_msg_time(stamp);
+    m->stamp_ns = static_cast<std::uint64_t>(time.sec_) * 1'000'000'000u + time.nanosec_;
     m->cdr.assign(cdr.begin(), cdr.end());
     bool post = false;
     {

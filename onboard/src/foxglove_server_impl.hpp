@@ -56,7 +56,6 @@ class FoxgloveServer::Impl {
   explicit Impl(Options options);
 
   Options options_;
-  std::int64_t offset_ns_;
   std::string session_id_;
   asio::io_context io_{1};
   std::optional<tcp::acceptor> acceptor_;
