@@ -129,12 +129,12 @@ void Estimator::process_imu(const QueuedImu& queued) {
   // The sample holds over (filter_time_, s.stamp]; fixes inside it split the interval.
   while (auto fix = gnss_buffer_.pop_until(s.stamp)) {
     const double dt = common::seconds_between(fix->stamp, filter_time_);
-    if (dt > 0.0) filter_->propagate(s.gyro, s.accel, dt);
+    if (dt > 0.0) propagate(s.gyro, s.accel, dt);
     filter_time_ = std::max(filter_time_, fix->stamp);
     apply_gnss(*fix);
   }
   const double dt = common::seconds_between(s.stamp, filter_time_);
-  if (dt > 0.0) filter_->propagate(s.gyro, s.accel, dt);
+  if (dt > 0.0) propagate(s.gyro, s.accel, dt);
   filter_time_ = s.stamp;
   last_imu_ = s;
   record_pose();
@@ -153,7 +153,7 @@ void Estimator::bridge_gap(common::Stamp to) {
     for (double left = common::seconds_between(until, filter_time_); left > 0.0;
          left = common::seconds_between(until, filter_time_)) {
       const double dt = std::min(kStep, left);
-      filter_->propagate(held.gyro, held.accel, dt);
+      propagate(held.gyro, held.accel, dt);
       filter_time_ = dt < left ? filter_time_ + dt : until;
     }
   };
@@ -230,6 +230,10 @@ void Estimator::try_initialise() {
   filter_->reset(x, p);
   filter_time_ = init_window_.back().stamp;
   initialised_ = true;
+  if (smoother_) {
+    const bool stood = counters_.init_not_static == 0;
+    smoother_->start(stood ? init_window_.front().stamp : filter_time_, x, filter_->covariance());
+  }
   init_window_.clear();
   init_fix_.reset();
   record_pose();
@@ -239,7 +243,25 @@ void Estimator::try_initialise() {
              pitch * 180.0 / std::numbers::pi, ic.yaw_rad * 180.0 / std::numbers::pi);
 }
 
+void Estimator::propagate(const Vector3d& gyro, const Vector3d& accel, double dt) {
+  if (smoother_) smoother_->propagate(filter_->state(), gyro, accel, dt);
+  filter_->propagate(gyro, accel, dt);
+}
+
+// A correction is a keyframe of the smoothing record: the filter before and after it.
 void Estimator::apply_gnss(const common::GnssFix& fix) {
+  if (!smoother_ || !smoother_->recording()) {
+    correct_with_gnss(fix);
+    return;
+  }
+  const NavState predicted = filter_->state();
+  const Matrix15 predicted_covariance = filter_->covariance();
+  correct_with_gnss(fix);
+  smoother_->correct(filter_time_, predicted, predicted_covariance, filter_->state(),
+                     filter_->covariance());
+}
+
+void Estimator::correct_with_gnss(const common::GnssFix& fix) {
   const Geodetic g{fix.latitude_deg, fix.longitude_deg, fix.altitude_m};
   const Vector3d y = local_->to_enu(g) - anchor_offset_;
   const CorrectionResult r =
@@ -347,6 +369,20 @@ void Estimator::record_pose() {
   pose.position = s.position;
   pose.velocity = s.velocity;
   history_.push(pose);
+  if (smoother_) smoother_->mark(filter_time_, s);
+}
+
+void Estimator::record_for_smoothing(double max_seconds) {
+  if (config_.filter != FilterKind::kLeftInekf) return;
+  constexpr double kPosePeriodS = 0.02;
+  smoother_.emplace(config_.params.gravity, max_seconds, kPosePeriodS);
+}
+
+std::vector<StampedPose> Estimator::finish_smoothing() {
+  if (!smoother_) return {};
+  std::vector<StampedPose> poses = smoother_->smooth();
+  smoother_.reset();
+  return poses;
 }
 
 std::optional<Estimate> Estimator::estimate() const {

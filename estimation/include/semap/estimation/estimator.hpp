@@ -12,6 +12,7 @@
 #include "semap/estimation/geodesy.hpp"
 #include "semap/estimation/gnss_reorder_buffer.hpp"
 #include "semap/estimation/imu_validator.hpp"
+#include "semap/estimation/inekf_rts_smoother.hpp"
 #include "semap/estimation/nav_filter.hpp"
 #include "semap/estimation/pose_history.hpp"
 
@@ -73,6 +74,14 @@ class Estimator {
   const NavFilter& filter() const { return *filter_; }
   double gate2() const { return gate2_; }
 
+  // Records the Left-InEKF's forward pass from its initialisation on, the last `max_seconds`
+  // of it, for smoothed_poses() (InekfRtsSmoother; the quaternion ESKF records nothing). The
+  // initialisation's static IMU window is part of it: the robot stood at the initial pose.
+  void record_for_smoothing(double max_seconds);
+  // The recorded poses smoothed by the fixes since (oldest first, about 50 per second of
+  // filter time, up to the filter time); ends the record.
+  std::vector<StampedPose> finish_smoothing();
+
  private:
   struct QueuedImu {
     common::ImuSample sample;
@@ -83,6 +92,8 @@ class Estimator {
   void collect_init_sample(const common::ImuSample& sample);
   void try_initialise();
   void apply_gnss(const common::GnssFix& fix);
+  void correct_with_gnss(const common::GnssFix& fix);
+  void propagate(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, double dt);
   void note_rejection(const Eigen::Vector3d& residual);
   void record_pose();
   void bridge_gap(common::Stamp to);
@@ -106,6 +117,7 @@ class Estimator {
   std::optional<common::ImuSample> last_imu_;  // the newest sample integrated
   std::vector<Eigen::Vector3d> rejected_run_;  // residuals of consecutive gated-out fixes
   int consecutive_rejections_ = 0;
+  std::optional<InekfRtsSmoother> smoother_;  // while recording for smoothing
 };
 
 // covariance_window: the Left-InEKF's (EstimatorConfig::covariance_window).
