@@ -1,21 +1,26 @@
 // Prints the mapping figures of issue 4: toy-dataset insertion time for S-BKI and S-CSM
 // (reference: 0.21 s on two threads, 0.38 s on one), the synthetic 64-beam LiDAR insertion
-// time over 100 scans, and bytes per allocated cell.
+// time over 100 scans, and bytes per allocated cell; `kitti-drive` is issue 34's S-BKI
+// measurement on the real KITTI scan.
 #include <tbb/global_control.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 #include "semap/common/process_usage.hpp"
+#include "semap/map_io/kitti_semantic_eval.hpp"
 #include "semap/map_io/pcd_io.hpp"
 #include "semap/mapping/semantic_map.hpp"
+#include "semap/perception/datasets/velodyne_bin.hpp"
 #include "synthetic_lidar.hpp"
 
 namespace {
@@ -269,6 +274,72 @@ void lidar_figures(int scans) {
       fusion_median * 1e3, plain_median * 1e3, plain_times.size(), plain_median / fusion_median);
 }
 
+// Issue 34's S-BKI figure: the real HDL-64 scan of KITTI odometry 00 (scan 0), mapped `scans`
+// times at origins 0.5 m apart along x as a drive would, SemanticKITTI's parameters
+// (kitti_semantic_params: ell 0.3, ds_res 0.1, 0.1 m cells, 20 classes) with hits within 30 m,
+// 2 threads. The scan has no labels: each point gets a class from its height (20 cm bands over
+// classes 1..19), so neighbouring cells share classes as in a labelled scan. Wall time of
+// insert(cloud, origin) per scan; the first is the first insert of this process.
+void kitti_drive_figures(int scans) {
+  const std::string path = std::string(SEMAP_SHARED_DATA_DIR) +
+                           "/real/kitti_odometry_00/sequences/00/velodyne/000000.bin";
+  if (!std::filesystem::exists(path)) {
+    std::printf("kitti-drive: skipped, %s is absent\n", path.c_str());
+    return;
+  }
+  const auto raw = semap::perception::datasets::read_velodyne_bin(path);
+  MapParams p = semap::map_io::kitti_semantic_params();
+  p.max_range = 30.0f;
+  LabeledCloud scan;
+  scan.num_classes = static_cast<std::uint16_t>(p.num_classes);
+  for (const Eigen::Vector4f& q : raw) {
+    scan.points.push_back(q.head<3>());
+    const int band = static_cast<int>(std::floor((q.z() + 3.0f) * 5.0f));
+    scan.labels.push_back(static_cast<std::uint16_t>(1 + ((band % 19) + 19) % 19));
+  }
+  std::printf(
+      "== kitti-drive: %s, %zu points, %d scans 0.5 m apart, res %.2f, K %d, depth %d, ell %.2f, "
+      "ds %.2f, free %.0f, range %.0f, 2 threads\n",
+      path.c_str(), scan.size(), scans, p.resolution, p.num_classes, p.block_depth, p.ell, p.ds_res,
+      p.free_res, p.max_range);
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+  SemanticMap map(p);
+  std::vector<double> times;
+  semap::mapping::InsertPhases phases;
+  std::size_t training = 0;
+  double cpu = 0;  // process CPU seconds, both threads, scans after the first
+  for (int s = 0; s < scans; ++s) {
+    LabeledCloud cloud = scan;
+    const Eigen::Vector3f shift(0.5f * static_cast<float>(s), 0.0f, 0.0f);
+    for (auto& q : cloud.points) q += shift;
+    cloud.origin = shift;
+    const double cpu0 = semap::common::process_cpu_seconds();
+    const auto start = Clock::now();
+    const auto result = map.insert(cloud, cloud.origin);
+    times.push_back(seconds_since(start));
+    if (s > 0) cpu += semap::common::process_cpu_seconds() - cpu0;
+    training += result.training_points;
+    if (s > 0) add_phases(phases, result.phases);
+  }
+  std::vector<double> sorted(times.begin() + 1, times.end());
+  std::sort(sorted.begin(), sorted.end());
+  const auto stats = map.stats();
+  std::printf("training points/scan %.0f  blocks %zu  observed cells %zu\n",
+              static_cast<double>(training) / scans, stats.blocks, stats.observed_cells);
+  if (sorted.empty()) return;
+  std::printf(
+      "insert after the first: median %.1f ms  p95 %.1f ms  max %.1f ms;  first scan %.1f ms\n",
+      sorted[sorted.size() / 2] * 1e3, sorted[sorted.size() * 95 / 100] * 1e3, sorted.back() * 1e3,
+      times.front() * 1e3);
+  const double n = static_cast<double>(sorted.size());
+  std::printf("cpu per scan after the first (both threads): mean %.1f ms\n", cpu / n * 1e3);
+  std::printf(
+      "phases after the first, mean ms: training %.2f prepare %.2f group %.2f blocks %.2f "
+      "scatter %.2f\n",
+      phases.training / n * 1e3, phases.prepare / n * 1e3, phases.group / n * 1e3,
+      phases.blocks / n * 1e3, phases.scatter / n * 1e3);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -277,5 +348,6 @@ int main(int argc, char** argv) {
   if (mode == "toy1") toy_figures(1);  // one repetition, for callgrind
   if (mode == "lidar" || mode == "all") lidar_figures(100);
   if (mode == "lidar10") lidar_figures(10);
+  if (mode == "kitti-drive") kitti_drive_figures(argc > 2 ? std::stoi(argv[2]) : 60);
   return 0;
 }

@@ -25,6 +25,7 @@ struct PlaneView {
   float* data;
   std::size_t plane;
   std::uint32_t* rows;
+  std::uint64_t* row_classes;
   std::uint32_t* job_rows;  // a point's rows: index in the tile,
   float* job_dyz2;          // dy^2 + dz^2,
   float* job_rest;          // and ell^2 - dyz2
@@ -80,7 +81,9 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
       count += d2[1][yy] < rest ? 1 : 0;
     }
   }
-  // Hard labels write to their label's plane only.
+  // Hard labels write to their label's plane only. Soft ones may touch every class.
+  const std::uint64_t classes =
+      kSoft ? ~std::uint64_t{0} : std::uint64_t{1} << static_cast<std::uint32_t>(label & 63);
   float* const first = planes.data + static_cast<std::size_t>(box.lo[0]) +
                        (kSoft ? 0 : static_cast<std::size_t>(label) * planes.plane);
 #if defined(__AVX2__)
@@ -135,6 +138,7 @@ void add_rows(const PlaneView& planes, const CellBox& box, const std::array<cons
     }
 #endif
     planes.rows[row] |= mask << shift;
+    planes.row_classes[row] |= classes;
   }
 }
 
@@ -146,6 +150,7 @@ PlaneTile::PlaneTile(std::int32_t side, int num_classes)
       plane_(static_cast<std::size_t>(side) * side * side),
       planes_(k_ * plane_ + kPad, 0.0f),
       rows_(static_cast<std::size_t>(side) * side, 0u),
+      row_classes_(rows_.size(), 0u),
       // Rows of one point: at most side^2, and 8 listed at once.
       job_rows_(static_cast<std::size_t>(side) * side + 8),
       job_dyz2_(job_rows_.size()),
@@ -156,6 +161,7 @@ void PlaneTile::add(const CellBox& box, const std::array<const float*, 3>& d2, s
   const PlaneView planes{planes_.data(),
                          plane_,
                          rows_.data(),
+                         row_classes_.data(),
                          job_rows_.data(),
                          job_dyz2_.data(),
                          job_rest_.data(),
@@ -193,6 +199,20 @@ void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& blo
                    static_cast<std::size_t>(first[0]);
       const int cell = block.cell_of(0, y, z);
       float* dst = block.cell_evidence_mutable(cell);
+      block.mark_observed_word(cell >> 6, bits << (cell & 63));
+      // Few classes (hard labels; K <= 64 so the mask covers them): those planes alone.
+      const std::uint64_t classes = row_classes_[row];
+      if (k <= 64 && static_cast<std::size_t>(std::popcount(classes)) * 4 <= k) {
+        for (std::uint64_t left = classes; left != 0; left &= left - 1) {
+          const auto c = static_cast<std::size_t>(std::countr_zero(left));
+          float* p = src + c * plane;
+          for (std::int32_t x = 0; x < n; ++x) {
+            dst[static_cast<std::size_t>(x) * k + c] += p[x];
+            p[x] = 0.0f;
+          }
+        }
+        continue;
+      }
       std::size_t c = 0;
 #if defined(__SSE2__)
       // Rows of 4 cells (blocks of depth 3): 4 classes at a time, a 4x4 transpose from
@@ -222,11 +242,29 @@ void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& blo
           p[x] = 0.0f;
         }
       }
-      block.mark_observed_word(cell >> 6, bits << (cell & 63));
     }
   }
 }
 
-void PlaneTile::clear_marks() { std::fill(rows_.begin(), rows_.end(), 0u); }
+void PlaneTile::prefetch_block(const std::array<std::int32_t, 3>& first, const Block& block) const {
+  const std::int32_t n = block.cells_per_side();
+  const std::uint64_t low = (std::uint64_t{1} << n) - 1;
+  constexpr std::size_t kLine = 64;
+  const std::size_t row_bytes = static_cast<std::size_t>(n) * k_ * sizeof(float);
+  for (std::int32_t z = 0; z < n; ++z) {
+    for (std::int32_t y = 0; y < n; ++y) {
+      const auto row = static_cast<std::size_t>((first[2] + z) * side_ + first[1] + y);
+      if (((std::uint64_t{rows_[row]} >> first[0]) & low) == 0) continue;
+      const char* bytes =
+          reinterpret_cast<const char*>(block.cell_evidence(block.cell_of(0, y, z)).data());
+      for (std::size_t b = 0; b < row_bytes; b += kLine) __builtin_prefetch(bytes + b, 1);
+    }
+  }
+}
+
+void PlaneTile::clear_marks() {
+  std::fill(rows_.begin(), rows_.end(), 0u);
+  std::fill(row_classes_.begin(), row_classes_.end(), std::uint64_t{0});
+}
 
 }  // namespace semap::mapping::detail

@@ -21,7 +21,9 @@ namespace semap::mapping::detail {
 // outside the sphere), where the blocks' cell-major layout would need 8 scattered floats K
 // apart. A vector may run up to 7 floats past the row into the next row (or the planes'
 // padding) adding +0.0 there, which leaves those cells unchanged. One bit mask per row of
-// cells records the cells that got weight: they are the only non-zero ones.
+// cells records the cells that got weight: they are the only non-zero ones; a second one per
+// row records the classes that did (hard labels: a few of K), so that flush_block moves only
+// those planes (adding the others' +0.0 would leave the block unchanged).
 class PlaneTile {
  public:
   PlaneTile(std::int32_t side, int num_classes);
@@ -37,6 +39,11 @@ class PlaneTile {
   // marks the cells that got weight as observed, and zeroes them here.
   void flush_block(const std::array<std::int32_t, 3>& first, Block& block);
 
+  // Asks the cache for the rows of `block` that flush_block(first, block) will update: the
+  // map's blocks are scattered in memory, and flushing one while the next is fetched hides
+  // most of the misses that otherwise dominate the flush.
+  void prefetch_block(const std::array<std::int32_t, 3>& first, const Block& block) const;
+
   // Clears the row masks once every block of the tile has been flushed.
   void clear_marks();
 
@@ -46,6 +53,7 @@ class PlaneTile {
   std::size_t plane_;  // floats per class plane
   std::vector<float> planes_;
   std::vector<std::uint32_t> rows_;
+  std::vector<std::uint64_t> row_classes_;  // bit c: class c got weight in the row (K <= 64)
   // The rows of the point being added: index in the tile, dy^2 + dz^2, ell^2 - that.
   std::vector<std::uint32_t> job_rows_;
   std::vector<float> job_dyz2_;

@@ -483,11 +483,23 @@ void TileInserter::scatter_in_place(const TilePlan& plan, Block& block,
 void TileInserter::write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile) const {
   const std::int32_t n = 1 << block_shift_;
   const std::int32_t t_side = blocks_per_tile_side_;
-  for (std::uint32_t j = plan.block_offsets[tile]; j < plan.block_offsets[tile + 1]; ++j) {
+  const auto first_cell = [&](std::uint32_t j) -> std::array<std::int32_t, 3> {
     const auto local = static_cast<std::int32_t>(plan.tile_blocks[j].local);
-    scratch.flush_block(
-        {(local % t_side) * n, ((local / t_side) % t_side) * n, (local / (t_side * t_side)) * n},
-        *plan.tile_blocks[j].block);
+    return {(local % t_side) * n, ((local / t_side) % t_side) * n, (local / (t_side * t_side)) * n};
+  };
+  // Blocks are fetched kPrefetchBlocks ahead of their flush.
+  constexpr std::uint32_t kPrefetchBlocks = 2;
+  const std::uint32_t begin = plan.block_offsets[tile];
+  const std::uint32_t end = plan.block_offsets[tile + 1];
+  for (std::uint32_t j = begin; j < std::min(end, begin + kPrefetchBlocks); ++j) {
+    scratch.prefetch_block(first_cell(j), *plan.tile_blocks[j].block);
+  }
+  for (std::uint32_t j = begin; j < end; ++j) {
+    if (j + kPrefetchBlocks < end) {
+      scratch.prefetch_block(first_cell(j + kPrefetchBlocks),
+                             *plan.tile_blocks[j + kPrefetchBlocks].block);
+    }
+    scratch.flush_block(first_cell(j), *plan.tile_blocks[j].block);
   }
   scratch.clear_marks();
 }

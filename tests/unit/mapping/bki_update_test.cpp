@@ -204,10 +204,12 @@ TEST_P(TiledEqualsPlain, OnRandomPoints) {
   EXPECT_GT(d.cells, 5000u);
 }
 
-// ell 0.3: 6-cell rows; ell 0.5: 10-cell rows, past the 8-lane row test.
+// ell 0.3: 6-cell rows; ell 0.5: 10-cell rows, past the 8-lane row test. K 20: rows with few
+// classes flush only those planes; K 70: past the 64-bit class masks, every plane.
 INSTANTIATE_TEST_SUITE_P(Layouts, TiledEqualsPlain,
                          ::testing::Values(std::make_tuple(3, 4, 0.3f),
                                            std::make_tuple(3, 20, 0.3f),
+                                           std::make_tuple(3, 70, 0.3f),
                                            std::make_tuple(2, 3, 0.3f), std::make_tuple(4, 5, 0.3f),
                                            std::make_tuple(6, 2, 0.3f), std::make_tuple(3, 3, 0.5f),
                                            std::make_tuple(4, 3, 0.5f)));
