@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace semap::mapping {
 
@@ -69,6 +70,10 @@ const Block* EvidenceGrid::find_block(const common::BlockIndex& key) const {
   if (!in_range(key)) return nullptr;
   const std::uint32_t id = table_.find(key);
   return id == VoxelHashMap::kNone || !resident_[id] ? nullptr : &blocks_[id];
+}
+
+Block* EvidenceGrid::find_block(const common::BlockIndex& key) {
+  return const_cast<Block*>(std::as_const(*this).find_block(key));
 }
 
 std::span<float> EvidenceGrid::cell(const common::CellIndex& cell) {

@@ -152,6 +152,9 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
   const BlockAt block_at = [this](const common::BlockIndex& index) -> Block& {
     return grid_->block_at(index);
   };
+  const detail::BlockFind find = [this](const common::BlockIndex& index) {
+    return grid_->find_block(index);
+  };
   if (params_.engine == Engine::kPlain) {
     const auto start = std::chrono::steady_clock::now();
     UpdateResult updated = plain_update(training, params_, block_at);
@@ -160,8 +163,9 @@ InsertResult SemanticMap::fuse(const TrainingSet& training, detail::TilePlan* pl
     result.rejected_points = updated.rejected_points;
     result.updated_blocks = std::move(updated.updated_blocks);
   } else {
-    detail::TileInsertResult fused = plan != nullptr ? inserter_->apply(*plan, training, block_at)
-                                                     : inserter_->insert(training, block_at);
+    detail::TileInsertResult fused = plan != nullptr
+                                         ? inserter_->apply(*plan, training, block_at, find)
+                                         : inserter_->insert(training, block_at, find);
     result.rejected_points = fused.rejected_points;
     result.phases = fused.phases;
     result.updated_blocks = std::move(fused.updated_blocks);

@@ -313,10 +313,12 @@ void TileInserter::group_by_tile(std::size_t count, TilePlan& plan) const {
                       }
                     });
   // 3. Tiles numbered by first occurrence: scratch tiles are few (toy: 8..18 per scan), so a
-  // short list searched from the last hit beats hashing every pair; many tiles (blocks
-  // written in place, or a list that grows past kFewTiles) take parallel hash shards.
-  const bool few = tile_shift_ != block_shift_ && number_few_tiles(pairs, plan);
-  if (!few) {
+  // short list searched from the last hit beats hashing every pair; more of them (a LiDAR
+  // scan: thousands) lie in a box small enough for a table indexed by position; many tiles
+  // spread wide (blocks written in place) take parallel hash shards.
+  const bool numbered = tile_shift_ != block_shift_ &&
+                        (number_few_tiles(pairs, plan) || number_dense_tiles(pairs, plan));
+  if (!numbered) {
     plan.tile_grouping.group(plan.pair_tiles, {});
     const auto ids = plan.tile_grouping.voxel_of();
     plan.pair_tile_ids.assign(ids.begin(), ids.end());
@@ -379,6 +381,42 @@ bool TileInserter::number_few_tiles(std::size_t pairs, TilePlan& plan) const {
   return true;
 }
 
+bool TileInserter::number_dense_tiles(std::size_t pairs, TilePlan& plan) const {
+  if (pairs == 0) return false;
+  std::array<std::int32_t, 3> lo{plan.pair_tiles[0].x, plan.pair_tiles[0].y, plan.pair_tiles[0].z};
+  std::array<std::int32_t, 3> hi = lo;
+  for (std::size_t j = 1; j < pairs; ++j) {
+    const common::BlockIndex& t = plan.pair_tiles[j];
+    lo = {std::min(lo[0], t.x), std::min(lo[1], t.y), std::min(lo[2], t.z)};
+    hi = {std::max(hi[0], t.x), std::max(hi[1], t.y), std::max(hi[2], t.z)};
+  }
+  std::array<std::size_t, 3> extent{};
+  for (int a = 0; a < 3; ++a) extent[a] = static_cast<std::size_t>(hi[a] - lo[a]) + 1;
+  // Tile coordinates span at most 2^21 per axis; the product is tested one factor at a time.
+  if (extent[0] > kDenseTiles || extent[1] > kDenseTiles / extent[0] ||
+      extent[2] > kDenseTiles / (extent[0] * extent[1])) {
+    return false;
+  }
+  constexpr std::uint32_t kNoTile = 0xFFFFFFFFu;
+  plan.dense_ids.assign(extent[0] * extent[1] * extent[2], kNoTile);
+  plan.tiles.clear();
+  plan.pair_tile_ids.resize(pairs);
+  for (std::size_t j = 0; j < pairs; ++j) {
+    const common::BlockIndex& t = plan.pair_tiles[j];
+    const std::size_t slot = (static_cast<std::size_t>(t.z - lo[2]) * extent[1] +
+                              static_cast<std::size_t>(t.y - lo[1])) *
+                                 extent[0] +
+                             static_cast<std::size_t>(t.x - lo[0]);
+    std::uint32_t& id = plan.dense_ids[slot];
+    if (id == kNoTile) {
+      id = static_cast<std::uint32_t>(plan.tiles.size());
+      plan.tiles.push_back(t);
+    }
+    plan.pair_tile_ids[j] = id;
+  }
+  return true;
+}
+
 void TileInserter::mark_blocks(std::size_t tile, TilePlan& plan) const {
   const std::int32_t ts = tile_shift_;
   const std::int32_t bs = block_shift_;
@@ -415,25 +453,41 @@ void TileInserter::mark_blocks(std::size_t tile, TilePlan& plan) const {
   }
 }
 
-void TileInserter::create_blocks(TilePlan& plan, const BlockAt& block_at,
+void TileInserter::create_blocks(TilePlan& plan, const BlockAt& block_at, const BlockFind& find,
                                  TileInsertResult& result) const {
   const std::int32_t t_side = blocks_per_tile_side_;
   const std::int32_t per_tile = tile_shift_ - block_shift_;
-  plan.block_offsets.assign(plan.tiles.size() + 1, 0);
-  plan.tile_blocks.clear();
-  for (std::size_t t = 0; t < plan.tiles.size(); ++t) {
+  const std::size_t tiles = plan.tiles.size();
+  plan.block_offsets.assign(tiles + 1, 0);
+  for (std::size_t t = 0; t < tiles; ++t) {
     const std::uint64_t* mask = plan.block_masks.data() + t * mask_words_;
+    std::uint32_t count = 0;
+    for (std::size_t w = 0; w < mask_words_; ++w) count += std::popcount(mask[w]);
+    plan.block_offsets[t + 1] = plan.block_offsets[t] + count;
+  }
+  plan.tile_blocks.resize(plan.block_offsets[tiles]);
+  result.updated_blocks.resize(plan.block_offsets[tiles]);
+  // The blocks the map holds are looked up in parallel (a LiDAR scan touches tens of
+  // thousands, most of them there already); the missing ones are then created serially, in
+  // the same order as one serial pass would.
+  tbb::parallel_for(std::size_t{0}, tiles, [&](std::size_t t) {
+    const std::uint64_t* mask = plan.block_masks.data() + t * mask_words_;
+    std::uint32_t j = plan.block_offsets[t];
     for (std::size_t w = 0; w < mask_words_; ++w) {
-      for (std::uint64_t bits = mask[w]; bits != 0; bits &= bits - 1) {
+      for (std::uint64_t bits = mask[w]; bits != 0; bits &= bits - 1, ++j) {
         const auto local = static_cast<std::int32_t>(w * 64) + std::countr_zero(bits);
         const common::BlockIndex index{(plan.tiles[t].x << per_tile) + local % t_side,
                                        (plan.tiles[t].y << per_tile) + (local / t_side) % t_side,
                                        (plan.tiles[t].z << per_tile) + local / (t_side * t_side)};
-        plan.tile_blocks.push_back({static_cast<std::uint32_t>(local), &block_at(index)});
-        result.updated_blocks.push_back(index);
+        plan.tile_blocks[j] = {static_cast<std::uint32_t>(local), find(index)};
+        result.updated_blocks[j] = index;
       }
     }
-    plan.block_offsets[t + 1] = static_cast<std::uint32_t>(plan.tile_blocks.size());
+  });
+  for (std::size_t j = 0; j < plan.tile_blocks.size(); ++j) {
+    if (plan.tile_blocks[j].block == nullptr) {
+      plan.tile_blocks[j].block = &block_at(result.updated_blocks[j]);
+    }
   }
 }
 
@@ -564,19 +618,20 @@ void TileInserter::plan(const TrainingSet& training, TilePlan& plan) const {
   plan.phases.group = clock.lap();
 }
 
-TileInsertResult TileInserter::insert(const TrainingSet& training, const BlockAt& block_at) {
+TileInsertResult TileInserter::insert(const TrainingSet& training, const BlockAt& block_at,
+                                      const BlockFind& find) {
   plan(training, plan_);
-  return apply(plan_, training, block_at);
+  return apply(plan_, training, block_at, find);
 }
 
 TileInsertResult TileInserter::apply(TilePlan& plan, const TrainingSet& training,
-                                     const BlockAt& block_at) {
+                                     const BlockAt& block_at, const BlockFind& find) {
   TileInsertResult result;
   result.rejected_points = plan.rejected_points;
   result.phases = plan.phases;
   PhaseClock clock;
   // Creating blocks mutates the map's table, so it happens before the parallel part.
-  create_blocks(plan, block_at, result);
+  create_blocks(plan, block_at, find, result);
   result.phases.blocks = clock.lap();
   // Blocks written in place are small (S-CSM: a few points each) and go in groups of
   // kBlocksPerTask to keep the task overhead down.

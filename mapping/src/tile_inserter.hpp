@@ -26,6 +26,10 @@
 
 namespace semap::mapping::detail {
 
+// The block at an index if the map holds it (resident), else nullptr; called from several
+// threads at once while the map is not changed.
+using BlockFind = std::function<Block*(const common::BlockIndex&)>;
+
 // What one insert touched, filled by TileInserter::insert.
 struct TileInsertResult {
   std::size_t rejected_points = 0;
@@ -58,6 +62,7 @@ struct TilePlan {
   std::vector<std::uint32_t> pair_points;
   VoxelGrouping tile_grouping;
   std::vector<std::uint32_t> pair_tile_ids;  // per pair: its tile's number
+  std::vector<std::uint32_t> dense_ids;      // number_dense_tiles' table
   std::vector<common::BlockIndex> tiles;
   std::vector<std::uint32_t> tile_offsets;  // tiles.size() + 1, into tile_points
   std::vector<std::uint32_t> tile_points;
@@ -86,13 +91,15 @@ class TileInserter {
 
   // Fuses `training`: plan() then apply(). Points with a bad label or unmappable coordinates
   // are rejected and counted. `block_at` returns the block at an index, creating it; it is
-  // called serially before the parallel part.
-  TileInsertResult insert(const TrainingSet& training, const BlockAt& block_at);
+  // called serially before the parallel part, for the blocks that `find` did not return.
+  TileInsertResult insert(const TrainingSet& training, const BlockAt& block_at,
+                          const BlockFind& find);
   // The map-independent part of insert: may run for a later scan (any number at once, each
   // with its own plan) while apply() fuses an earlier one.
   void plan(const TrainingSet& training, TilePlan& plan) const;
   // Creates the plan's missing blocks and adds the training set's weights to the map.
-  TileInsertResult apply(TilePlan& plan, const TrainingSet& training, const BlockAt& block_at);
+  TileInsertResult apply(TilePlan& plan, const TrainingSet& training, const BlockAt& block_at,
+                         const BlockFind& find);
 
  private:
   void prepare_points(const TrainingSet& training, TilePlan& plan) const;
@@ -100,8 +107,12 @@ class TileInserter {
   // Numbers the pairs' tiles by first occurrence (tiles, pair_tile_ids) with a linear
   // list; false when more than kFewTiles distinct tiles appear (then nothing is numbered).
   bool number_few_tiles(std::size_t pairs, TilePlan& plan) const;
+  // The same through a dense table over the tiles' bounding box; false when that box holds
+  // more than kDenseTiles tiles (then nothing is numbered).
+  bool number_dense_tiles(std::size_t pairs, TilePlan& plan) const;
   void mark_blocks(std::size_t tile, TilePlan& plan) const;
-  void create_blocks(TilePlan& plan, const BlockAt& block_at, TileInsertResult& result) const;
+  void create_blocks(TilePlan& plan, const BlockAt& block_at, const BlockFind& find,
+                     TileInsertResult& result) const;
   void process_tile(const TilePlan& plan, std::size_t tile, const TrainingSet& training);
   Piece piece_of(const TilePlan& plan, std::size_t i,
                  const std::array<std::int32_t, 3>& base) const;
@@ -117,6 +128,7 @@ class TileInserter {
   std::size_t mask_words_;  // 64-bit words of a tile's block mask
   std::size_t width_;       // distances stored per point and axis
   static constexpr std::size_t kFewTiles = 64;
+  static constexpr std::size_t kDenseTiles = std::size_t{1} << 22;
 
   TilePlan plan_;                                       // of insert()
   tbb::enumerable_thread_specific<PlaneTile> scratch_;  // created on first use per thread

@@ -45,6 +45,7 @@ class EvidenceGrid {
   Block& block_at(const common::BlockIndex& key);
   // The block at `key` if it is in memory.
   const Block* find_block(const common::BlockIndex& key) const;
+  Block* find_block(const common::BlockIndex& key);
 
   // Channels of one cell, creating its block and marking the cell observed.
   std::span<float> cell(const common::CellIndex& cell);
