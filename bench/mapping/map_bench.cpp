@@ -307,7 +307,8 @@ void kitti_drive_figures(int scans) {
   std::vector<double> times;
   semap::mapping::InsertPhases phases;
   std::size_t training = 0;
-  double cpu = 0;  // process CPU seconds, both threads, scans after the first
+  double cpu = 0;           // process CPU seconds, both threads, scans after the first
+  std::size_t updated = 0;  // blocks
   for (int s = 0; s < scans; ++s) {
     LabeledCloud cloud = scan;
     const Eigen::Vector3f shift(0.5f * static_cast<float>(s), 0.0f, 0.0f);
@@ -319,13 +320,16 @@ void kitti_drive_figures(int scans) {
     times.push_back(seconds_since(start));
     if (s > 0) cpu += semap::common::process_cpu_seconds() - cpu0;
     training += result.training_points;
+    updated += result.blocks_updated;
     if (s > 0) add_phases(phases, result.phases);
   }
   std::vector<double> sorted(times.begin() + 1, times.end());
   std::sort(sorted.begin(), sorted.end());
   const auto stats = map.stats();
-  std::printf("training points/scan %.0f  blocks %zu  observed cells %zu\n",
-              static_cast<double>(training) / scans, stats.blocks, stats.observed_cells);
+  std::printf(
+      "training points/scan %.0f  blocks updated/scan %.0f  blocks %zu  observed cells %zu\n",
+      static_cast<double>(training) / scans, static_cast<double>(updated) / scans, stats.blocks,
+      stats.observed_cells);
   if (sorted.empty()) return;
   std::printf(
       "insert after the first: median %.1f ms  p95 %.1f ms  max %.1f ms;  first scan %.1f ms\n",
