@@ -22,6 +22,9 @@ EstimationStage::EstimationStage(const EstimationStageConfig& config,
       pose_sink_(std::move(pose_sink)),
       fix_sink_(std::move(fix_sink)),
       estimator_(config.estimator) {
+  if (config.smoothing_seconds > 0.0) {
+    estimator_.record_for_smoothing(config.smoothing_seconds + config.smoothing_lag_s);
+  }
   if (!config.trajectory.empty()) {
     trajectory_ = std::make_unique<TrajectoryLog>(config.trajectory, config.trajectory_offset_ns);
   }
@@ -91,19 +94,42 @@ bool EstimationStage::drain_sensors() {
 }
 
 // The yaw variance needs the covariance, which the InEKF forms on demand: ten checks per
-// second of filter time until the heading has settled once.
+// second of filter time until the heading has settled, and, with frames held from before, until
+// it is known well enough to smooth their seconds (smoothing_heading_sigma_deg, or at the
+// latest smoothing_lag_s after it settled): the smoothed poses of those seconds are about as
+// good as the filter's heading at that moment, and a short run must not end first.
 void EstimationStage::check_heading() {
-  if (stage_.figures().heading_settled || !estimator_.initialised()) return;
+  const bool smoothing = config_.smoothing_seconds > 0.0 && !smoothed_given_;
+  auto& settled = stage_.figures().heading_settled;
+  if ((settled && !smoothing) || !estimator_.initialised()) return;
   const common::Stamp now = estimator_.filter_time();
   if (now < next_heading_check_) return;
   next_heading_check_ = now + 0.1;
   const double yaw_sigma_deg =
       std::sqrt(estimator_.filter().rotation_covariance_world()(2, 2)) * 180.0 / std::numbers::pi;
-  if (yaw_sigma_deg > config_.map_start_heading_sigma_deg) return;
-  stage_.figures().heading_settled = now;
+  if (!settled) {
+    if (yaw_sigma_deg > config_.map_start_heading_sigma_deg) return;
+    settled = now;
+    common::logger("estimation")
+        ->info("heading settled (sigma {:.2f} deg): camera frames are mapped from now on",
+               yaw_sigma_deg);
+  }
+  if (smoothing && (yaw_sigma_deg <= config_.smoothing_heading_sigma_deg ||
+                    common::seconds_between(now, *settled) >= config_.smoothing_lag_s)) {
+    share_smoothed(yaw_sigma_deg);
+  }
+}
+
+void EstimationStage::share_smoothed(double yaw_sigma_deg) {
+  const std::vector<estimation::StampedPose> smoothed = estimator_.finish_smoothing();
+  poses_.set_smoothed(smoothed);
+  smoothed_given_ = true;
+  stage_.figures().smoothed_poses = smoothed.size();
   common::logger("estimation")
-      ->info("heading settled (sigma {:.2f} deg): camera frames are mapped from now on",
-             yaw_sigma_deg);
+      ->info(
+          "heading sigma {:.2f} deg: the frames held from before it settled are mapped at {} "
+          "smoothed poses",
+          yaw_sigma_deg, smoothed.size());
 }
 
 // Reading the InEKF's covariance forms it from the window of deferred IMU steps (exactly, and

@@ -189,7 +189,12 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   if (checkpoint_) checkpoint_->after_insert(result);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
+  // A cloud older than one already mapped was held from before the heading was known
+  // (PerceptionStage): late on purpose, it would only hide the live latency.
+  if (cloud.stamp >= newest_mapped_) {
+    newest_mapped_ = cloud.stamp;
+    latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
+  }
   insert_time_.record(seconds);
   stage_.figures().scans++;
   stage_.figures().points += cloud.size();

@@ -246,6 +246,12 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
   c.map.robot_id = static_cast<mapping::SourceId>(map.get_in_range("robot_id", 1, 1, 65535));
   c.map.start_heading_sigma_deg =
       map.get_in_range("start_heading_sigma_deg", c.map.start_heading_sigma_deg, 0.01, 180.0);
+  c.map.hold_seconds = map.get_in_range("hold_seconds", c.map.hold_seconds, 0.0, 600.0);
+  c.map.hold_bytes = static_cast<std::size_t>(
+      map.get_in_range("hold_bytes", static_cast<double>(c.map.hold_bytes), 0.0, 64e9));
+  c.map.hold_heading_sigma_deg =
+      map.get_in_range("hold_heading_sigma_deg", c.map.hold_heading_sigma_deg, 0.01, 180.0);
+  c.map.hold_lag_s = map.get_in_range("hold_lag_s", c.map.hold_lag_s, 0.0, 600.0);
   c.map.max_position_sigma_m =
       map.get_in_range("max_position_sigma_m", c.map.max_position_sigma_m, 0.0, 1000.0);
   map.finish();

@@ -93,7 +93,7 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
                                  common::SpscRing<common::PointScan>* scans,
                                  const SharedPoseHistory& poses,
                                  common::SpscRing<common::LabeledCloud>& clouds,
-                                 double max_position_sigma_m)
+                                 double max_position_sigma_m, HoldBuffer hold)
     : camera_(camera),
       depth_(depth),
       segmenter_(std::move(segmenter)),
@@ -103,7 +103,8 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
       poses_(poses),
       cloud_ring_(clouds),
       max_position_sigma_m_(max_position_sigma_m),
-      body_from_optical_(camera.body_from_optical()) {
+      body_from_optical_(camera.body_from_optical()),
+      hold_(std::move(hold)) {
   if (!segmenter_) throw std::invalid_argument("perception stage: no segmenter");
   if (depth_.source == DepthSource::kAligned && !depth_ring_) {
     throw std::invalid_argument("perception stage: aligned depth needs a depth frame ring");
@@ -160,10 +161,14 @@ void PerceptionStage::run(std::stop_token stop) {
   figures.unpaired += lidar ? scan_pending_.size() : colour_pending_.size();
   figures.partner_unused += lidar ? colour_pending_.size() : depth_pending_.size();
   figures.without_pose += unposed_.size();
+  count_hold_drops(hold_.size() + held_posed_.size());
   colour_pending_.clear();
   depth_pending_.clear();
   scan_pending_.clear();
   unposed_.clear();
+  while (!hold_.empty()) hold_.pop_front();
+  held_posed_.clear();
+  figures.holding = 0;
   share_stats();
 }
 
@@ -171,6 +176,7 @@ bool PerceptionStage::step() {
   bool worked = take_frames();
   worked = process_next() || worked;
   worked = pose_clouds() || worked;
+  worked = release_held() || worked;
   share_stats();
   return worked;
 }
@@ -347,12 +353,24 @@ void PerceptionStage::queue_for_pose(common::LabeledCloud body_cloud, common::St
 
 bool PerceptionStage::pose_clouds() {
   bool any = false;
+  auto& figures = stage_.figures();
   while (!unposed_.empty()) {
     const auto lookup = poses_.at(unposed_.front().cloud.stamp);
     if (lookup.status == SharedPoseHistory::Status::kPending) break;
     any = true;
+    // Before the heading is known, and until the smoothed poses of those seconds are given.
+    if (lookup.status != SharedPoseHistory::Status::kPosed && hold_.enabled() &&
+        !poses_.smoothed_given()) {
+      ++figures.held;
+      hold_.push(std::move(unposed_.front().cloud), unposed_.front().sequence);
+      unposed_.pop_front();
+      figures.hold_bytes_max = std::max<std::uint64_t>(figures.hold_bytes_max, hold_.bytes());
+      count_hold_drops(hold_.dropped() - hold_dropped_seen_);
+      hold_dropped_seen_ = hold_.dropped();
+      continue;
+    }
     if (lookup.status != SharedPoseHistory::Status::kPosed) {
-      ++stage_.figures().without_pose;
+      ++figures.without_pose;
       unposed_.pop_front();
       continue;
     }
@@ -362,14 +380,53 @@ bool PerceptionStage::pose_clouds() {
     }
     common::LabeledCloud cloud =
         mapping::transform_cloud(std::move(unposed_.front().cloud), lookup.pose.world_from_body());
-    const common::Stamp stamp = cloud.stamp;
-    stage_.figures().points += cloud.size();
     unposed_.pop_front();
-    cloud_ring_.try_push(std::move(cloud));  // drop-oldest: the ring counts what it drops
-    ++stage_.figures().clouds;
+    const common::Stamp stamp = cloud.stamp;
+    hand_over(std::move(cloud));
+    live_handed_over_ = true;
     latency_.record(common::seconds_between(common::Stamp::now(), stamp));
   }
+  figures.holding = hold_.size() + held_posed_.size();
   return any;
+}
+
+// Held clouds are posed all at once when the smoothed poses of their seconds are given, then go to
+// the mapping stage one at a time into an empty ring, after the first live cloud: the backlog fills
+// the mapping stage's idle time, live clouds keep their place and the ring drops none.
+bool PerceptionStage::release_held() {
+  bool any = false;
+  auto& figures = stage_.figures();
+  while (!hold_.empty()) {
+    const auto lookup = poses_.smoothed_at(hold_.front().cloud.stamp);
+    if (lookup.status == SharedPoseHistory::Status::kNoFilter) break;
+    any = true;
+    if (lookup.status == SharedPoseHistory::Status::kTooOld) {
+      count_hold_drops(1);  // outside the smoothed seconds (before the filter's first pose)
+    } else if (!too_uncertain(lookup.pose)) {
+      held_posed_.push_back(
+          mapping::transform_cloud(std::move(hold_.front().cloud), lookup.pose.world_from_body()));
+    }
+    hold_.pop_front();
+  }
+  if (!held_posed_.empty() && live_handed_over_ && cloud_ring_.empty()) {
+    hand_over(std::move(held_posed_.front()));
+    held_posed_.pop_front();
+    any = true;
+  }
+  figures.holding = hold_.size() + held_posed_.size();
+  return any;
+}
+
+// A posed cloud (world frame) to the mapping stage.
+void PerceptionStage::hand_over(common::LabeledCloud cloud) {
+  stage_.figures().points += cloud.size();
+  cloud_ring_.try_push(std::move(cloud));  // drop-oldest: the ring counts what it drops
+  ++stage_.figures().clouds;
+}
+
+void PerceptionStage::count_hold_drops(std::uint64_t n) {
+  stage_.figures().without_pose += n;
+  stage_.figures().hold_dropped += n;
 }
 
 // Counts a cloud whose pose is too uncertain to map, and logs when mapping pauses and resumes.

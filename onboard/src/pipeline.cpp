@@ -76,7 +76,8 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
           make_segmenter(config_.segmenter, config_.map.params.num_classes), colour_ring_,
           source == DepthSource::kAligned ? &depth_ring_ : nullptr,
           source == DepthSource::kLidar ? &scan_ring_ : nullptr, poses_, cloud_ring_,
-          config_.map.max_position_sigma_m);
+          config_.map.max_position_sigma_m,
+          HoldBuffer(config_.map.hold_seconds, config_.map.hold_bytes));
       log->info("perception: {}", perception_->describe());
     } catch (const std::exception& e) {
       log->error("perception disabled, running without a map: {}", e.what());
@@ -91,6 +92,13 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
       config_.map, cloud_ring_,
       [this](const std::vector<common::BlockIndex>& changed,
              const std::vector<common::BlockIndex>& paged_out) {
+        if (!first_blocks_logged_ && !changed.empty()) {
+          first_blocks_logged_ = true;
+          common::logger("onboard")->info(
+              "first map blocks ({}) ready to publish {:.2f} s after start", changed.size(),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - constructed_)
+                  .count());
+        }
         if (dds_) dds_->blocks_changed(changed, paged_out);
         for (PipelineObserver* o : observers_) o->on_mapped(changed);
       },
@@ -102,8 +110,17 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
                                         &mapping_->costmaps());
   }
 
-  EstimationStageConfig estimation{config_.estimator, config_.map.start_heading_sigma_deg,
-                                   config_.dds.odometry_hz, trajectory, rig_->stamp_offset_ns()};
+  EstimationStageConfig estimation;
+  estimation.estimator = config_.estimator;
+  estimation.map_start_heading_sigma_deg = config_.map.start_heading_sigma_deg;
+  estimation.odometry_hz = config_.dds.odometry_hz;
+  estimation.trajectory = trajectory;
+  estimation.trajectory_offset_ns = rig_->stamp_offset_ns();
+  // Without a perception stage nothing is held, so nothing is recorded for smoothing.
+  const bool holding = perception_ && config_.map.hold_seconds > 0.0 && config_.map.hold_bytes > 0;
+  estimation.smoothing_seconds = holding ? config_.map.hold_seconds : 0.0;
+  estimation.smoothing_heading_sigma_deg = config_.map.hold_heading_sigma_deg;
+  estimation.smoothing_lag_s = config_.map.hold_lag_s;
   if (const auto frame = mapping_->map_frame()) {
     estimation.estimator.anchor = checkpoint_anchor(*frame, config_.estimator.anchor);
     log->info("map frame anchored at {:.8f}, {:.8f}, {:.2f} (from the checkpoint)",
@@ -224,8 +241,8 @@ bool Pipeline::has_taken(const HandedOver& handed) const {
   if (e.imu_samples < handed.imu_samples || e.gnss_fixes < handed.gnss_fixes) return false;
   if (!perception_) return true;
   const auto p = perception_->stats();
-  const auto done =
-      p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose + p.uncertain_pose;
+  const auto done = p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose +
+                    p.uncertain_pose + p.holding;
   // One cloud in the ring (capacity depth.ring >= 2) and none dropped: the same map as when
   // waiting for each insert, at the pace of the slower stage instead of the sum of both.
   return p.frames == handed.frames && done == p.frames &&

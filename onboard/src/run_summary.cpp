@@ -24,6 +24,12 @@ void perception_summary(const PerceptionStage& perception, std::vector<std::stri
                   p.clouds ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
                   1e3 * p.segment_seconds_max, static_cast<double>(lat.p50_ms),
                   static_cast<double>(lat.p99_ms)));
+  if (p.held > 0) {
+    lines.push_back(fmt::format(
+        "held frames      : {} taken before the heading was known, held for smoothed poses; {} "
+        "of them dropped (hold bounds, no pose, the run's end), {:.1f} MB held at most",
+        p.held, p.hold_dropped, static_cast<double>(p.hold_bytes_max) / 1e6));
+  }
   lines.push_back(fmt::format(
       "pixels dropped   : {} no depth, {} out of range, {} no label, {} low confidence",
       p.dropped.no_depth, p.dropped.out_of_range, p.dropped.no_label, p.dropped.low_confidence));

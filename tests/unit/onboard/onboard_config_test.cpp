@@ -165,6 +165,33 @@ TEST(OnboardConfig, MapCheckpointAndMemoryRadius) {
   EXPECT_NE(no_log.find("needs the checkpoint log"), std::string::npos) << no_log;
 }
 
+// map.hold_*: the frames held until the heading is known; a bad value names the key, the file
+// and the line.
+TEST(OnboardConfig, MapHoldKeys) {
+  const OnboardConfig defaults = load(kConfigDir / "sim.yaml");
+  EXPECT_DOUBLE_EQ(defaults.map.hold_seconds, 20.0);
+  EXPECT_EQ(defaults.map.hold_bytes, std::size_t{256} << 20);
+  EXPECT_DOUBLE_EQ(defaults.map.hold_heading_sigma_deg, 1.0);
+  EXPECT_DOUBLE_EQ(defaults.map.hold_lag_s, 5.0);
+  const auto path = edited_sim("  start_heading_sigma_deg: 3 ",
+                               "  hold_seconds: 12\n  hold_bytes: 1000000\n"
+                               "  hold_heading_sigma_deg: 0.5\n  start_heading_sigma_deg: 3 ");
+  const OnboardConfig c = load(path);
+  std::filesystem::remove(path);
+  EXPECT_DOUBLE_EQ(c.map.hold_seconds, 12.0);
+  EXPECT_EQ(c.map.hold_bytes, 1000000u);
+  EXPECT_DOUBLE_EQ(c.map.hold_heading_sigma_deg, 0.5);
+  const std::string negative = error_of(edited_sim(
+      "  start_heading_sigma_deg: 3 ", "  hold_seconds: -1\n  start_heading_sigma_deg: 3 "));
+  EXPECT_NE(negative.find("map.hold_seconds"), std::string::npos) << negative;
+  EXPECT_NE(negative.find("semap_onboard_config_"), std::string::npos) << negative;
+  EXPECT_NE(negative.find(":62"), std::string::npos) << negative;
+  const std::string sigma =
+      error_of(edited_sim("  start_heading_sigma_deg: 3 ",
+                          "  hold_heading_sigma_deg: 0\n  start_heading_sigma_deg: 3 "));
+  EXPECT_NE(sigma.find("map.hold_heading_sigma_deg"), std::string::npos) << sigma;
+}
+
 TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
   EXPECT_NE(error_of(edited_sim("fov_deg: 90", "fov_deg: 90\n  ring: 6"))
                 .find("camera.ring': 6 is not a power of two"),

@@ -85,14 +85,15 @@ class PerceptionStageTest : public ::testing::Test {
     depth_.points.max_range = 20.0f;
   }
 
-  std::unique_ptr<PerceptionStage> make_stage(double max_position_sigma_m = 0.0) {
+  std::unique_ptr<PerceptionStage> make_stage(double max_position_sigma_m = 0.0,
+                                              HoldBuffer hold = HoldBuffer(0.0, 0)) {
     perception::PaletteOptions options;
     options.confidence = 0.8f;
     return std::make_unique<PerceptionStage>(
         camera_, depth_,
         std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(), kClasses,
                                                        options),
-        colour_, &depth_ring_, nullptr, poses_, clouds_, max_position_sigma_m);
+        colour_, &depth_ring_, nullptr, poses_, clouds_, max_position_sigma_m, std::move(hold));
   }
 
   void push_pair(double t, std::uint32_t sequence) {
@@ -164,6 +165,71 @@ TEST_F(PerceptionStageTest, CountsFramesWithoutAPose) {
   EXPECT_TRUE(clouds_.empty());
   EXPECT_EQ(stage->stats().without_pose, 2u);
   EXPECT_EQ(stage->stats().clouds, 0u);
+}
+
+// map.hold_seconds: frames taken before the pose history has poses (the heading is not known
+// yet) are held, and mapped at their own stamps once poses for them appear (the smoothed ones),
+// after the first live frame and one at a time into an empty cloud ring; a frame older than the
+// first pose is counted without a pose, and so is one still held when the stage stops.
+TEST_F(PerceptionStageTest, HoldsFramesBeforeTheFirstPosesAndMapsThemAtTheirStamps) {
+  auto stage = make_stage(0.0, HoldBuffer(10.0, std::size_t{64} << 20));
+  push_pair(0.5, 1);  // before any pose
+  stage->step();
+  push_pair(1.2, 2);
+  stage->step();
+  push_pair(1.5, 3);
+  stage->step();
+  EXPECT_TRUE(clouds_.empty());
+  auto s = stage->stats();
+  EXPECT_EQ(s.held, 3u);
+  EXPECT_EQ(s.holding, 3u);
+  EXPECT_EQ(s.without_pose, 0u);
+  EXPECT_GT(s.hold_bytes_max, 0u);
+
+  poses_.append(drive(2.0, 3.0));  // the heading is known from 2 s
+  push_pair(2.5, 4);               // a live frame
+  while (stage->step()) {
+  }
+  push_pair(1.8, 5);  // late, from before 2 s: held too
+  while (stage->step()) {
+  }
+  EXPECT_EQ(stage->stats().held, 4u);
+  poses_.set_smoothed(drive(1.0, 2.0));  // later: the smoothed poses of those seconds
+  while (stage->step()) {
+  }
+  std::vector<float> mapped_x;
+  LabeledCloud cloud;
+  while (clouds_.try_pop(cloud)) {
+    mapped_x.push_back(cloud.origin.x() - camera_.mount_xyz.x());
+    while (stage->step()) {  // the next held one goes into the emptied ring
+    }
+  }
+  // The live frame first, then the held ones at the poses of their own stamps (x = 2 t).
+  ASSERT_EQ(mapped_x.size(), 4u);
+  EXPECT_NEAR(mapped_x[0], 5.0f, 1e-3f);
+  EXPECT_NEAR(mapped_x[1], 2.4f, 1e-3f);
+  EXPECT_NEAR(mapped_x[2], 3.0f, 1e-3f);
+  EXPECT_NEAR(mapped_x[3], 3.6f, 1e-3f);
+  s = stage->stats();
+  EXPECT_EQ(s.clouds, 4u);
+  EXPECT_EQ(s.without_pose, 1u);  // the frame at 0.5 s, older than the first pose
+  EXPECT_EQ(s.hold_dropped, 1u);
+  EXPECT_EQ(s.holding, 0u);
+  EXPECT_EQ(s.clouds + s.without_pose, s.frames);
+}
+
+TEST_F(PerceptionStageTest, CountsHeldFramesLeftWhenItStops) {
+  auto stage = make_stage(0.0, HoldBuffer(10.0, std::size_t{64} << 20));
+  push_pair(0.5, 1);
+  push_pair(0.6, 2);
+  stage->start();
+  while (stage->stats().holding < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  stage->stop();
+  const auto s = stage->stats();
+  EXPECT_EQ(s.clouds, 0u);
+  EXPECT_EQ(s.holding, 0u);
+  EXPECT_EQ(s.skipped + s.without_pose, s.frames);
+  EXPECT_EQ(s.hold_dropped, s.held);
 }
 
 // map.max_position_sigma_m: a frame posed while the filter's position sigma is above the limit

@@ -25,6 +25,8 @@ struct EstimationStageStats {
   std::uint64_t poses_published = 0;
   // When the heading first met map.start_heading_sigma_deg; poses go to perception from then.
   std::optional<common::Stamp> heading_settled;
+  // Poses from before then, smoothed later (map.hold_seconds > 0) for the frames held then.
+  std::uint64_t smoothed_poses = 0;
   bool initialised = false;
   estimation::EstimatorCounters estimator;
   // The filter's state, with its position sigma as last read (see EstimationStage).
@@ -46,6 +48,14 @@ struct PoseOutput {
 struct EstimationStageConfig {
   estimation::EstimatorConfig estimator;
   double map_start_heading_sigma_deg = 3.0;
+  // > 0 (map.hold_seconds): the filter's forward pass from its start is recorded (the last
+  // smoothing_seconds + smoothing_lag_s of it) and, once the heading sigma is below
+  // smoothing_heading_sigma_deg (map.hold_heading_sigma_deg) or at the latest smoothing_lag_s
+  // (map.hold_lag_s) after it settled, smoothed into the poses of the frames held from before
+  // it settled (SharedPoseHistory::set_smoothed).
+  double smoothing_seconds = 0.0;
+  double smoothing_heading_sigma_deg = 1.0;
+  double smoothing_lag_s = 5.0;
   double odometry_hz = 50.0;
   std::filesystem::path trajectory;  // --trajectory: every pose as CSV (TrajectoryLog)
   std::int64_t trajectory_offset_ns = 0;
@@ -53,7 +63,10 @@ struct EstimationStageConfig {
 
 // Owns the Estimator on its own thread: drains the IMU and GNSS rings in stamp order and
 // shares the filter's poses with the perception stage, which poses frames at their stamps,
-// once the filter's heading has settled (map.start_heading_sigma_deg). Each pose carries the
+// once the filter's heading has settled (map.start_heading_sigma_deg); later, once it is known
+// better still, the poses from the filter's start until then, smoothed by a Rauch-Tung-Striebel
+// pass over its record (Estimator::finish_smoothing), for the frames perception held. Each pose
+// carries the
 // filter's position sigma (estimation::position_sigma_m of its position covariance), read 20
 // times per second of filter time and after every GNSS correction or covariance inflation (the
 // InEKF forms its covariance on demand; between reads a pose carries the last one).
@@ -82,6 +95,7 @@ class EstimationStage {
   bool drain_sensors();
   void publish_pose();
   void check_heading();
+  void share_smoothed(double yaw_sigma_deg);
   double position_sigma();
   void share_stats();
 
@@ -93,6 +107,7 @@ class EstimationStage {
   FixSink fix_sink_;
   estimation::Estimator estimator_;
   std::vector<estimation::StampedPose> new_poses_;
+  bool smoothed_given_ = false;
   std::unique_ptr<TrajectoryLog> trajectory_;
   common::Stamp next_heading_check_;
   common::Stamp next_sigma_read_;

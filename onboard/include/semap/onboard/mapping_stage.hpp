@@ -67,7 +67,8 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   void start(std::vector<int> cpus = {});
   void stop();
   MappingStageStats stats() const;
-  // Age of each cloud (its image's capture stamp) once it is in the map.
+  // Age of each cloud (its image's capture stamp) once it is in the map; clouds held from
+  // before the heading was known (older than one already mapped) are left out.
   const common::LatencyWindow& latency() const { return latency_; }
   // Time each insert took.
   const common::LatencyWindow& insert_time() const { return insert_time_; }
@@ -117,6 +118,7 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   std::unique_ptr<mapping::SemanticMap> full_map_;  // map() with a pager
   std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
   common::LatencyWindow latency_;
+  common::Stamp newest_mapped_;  // clouds older than this were held back: not in latency_
   common::LatencyWindow insert_time_;
   std::unique_ptr<WriteFailureLog> write_log_;  // with a checkpoint
   StageThread<MappingStageStats> stage_;        // last: joined before the members it uses

@@ -108,6 +108,14 @@ struct MappingConfig {
   // Frames are mapped only once the filter's heading is known to within this (1 sigma):
   // a filter that starts from a guessed heading would otherwise smear the map.
   double start_heading_sigma_deg = 3.0;
+  // The clouds of frames taken before then are held, the last hold_seconds of them within
+  // hold_bytes (the oldest go first, counted), and mapped at the poses the smoother gives
+  // their stamps once the heading sigma is below hold_heading_sigma_deg, or at the latest
+  // hold_lag_s after it settled (docs/perception.md). 0 seconds or bytes: dropped.
+  double hold_seconds = 20.0;
+  std::size_t hold_bytes = std::size_t{256} << 20;
+  double hold_heading_sigma_deg = 1.0;
+  double hold_lag_s = 5.0;
   // Clouds posed while the filter's position sigma (1 sigma, least certain axis) is above this
   // are not mapped: mapping pauses through a long GNSS outage and resumes when fixes return.
   // 0 turns the check off.

@@ -11,6 +11,7 @@
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/drivers/jpeg_decoder.hpp"
+#include "semap/onboard/hold_buffer.hpp"
 #include "semap/onboard/perception_config.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
 #include "semap/onboard/stage_thread.hpp"
@@ -33,6 +34,13 @@ struct PerceptionStageStats {
   std::uint64_t partner_unused = 0;  // depth frames (LiDAR mode: colour frames) left unpaired
   std::uint64_t bad_frames = 0;      // undecodable, wrong format or wrong size
   std::uint64_t without_pose = 0;    // before the filter started, or older than its history
+  // Frames taken before the filter's heading was known, held for the poses the smoother gives
+  // those seconds once it is (HoldBuffer); of them, those dropped from the hold (its bounds,
+  // poses that never came, the run's end) are also counted without_pose.
+  std::uint64_t held = 0;
+  std::uint64_t hold_dropped = 0;
+  std::uint64_t holding = 0;         // held now, not yet mapped nor dropped
+  std::uint64_t hold_bytes_max = 0;  // the most memory the held clouds took
   // Posed while the filter's position sigma was above map.max_position_sigma_m (a GNSS outage):
   // mapping pauses rather than smear the map.
   std::uint64_t uncertain_pose = 0;
@@ -50,6 +58,10 @@ struct PerceptionStageStats {
 // position sigma is above `max_position_sigma_m` (> 0; map.max_position_sigma_m): such a cloud
 // is dropped and counted (uncertain_pose), so mapping pauses while the filter is unsure where
 // it is and resumes when it knows again.
+// Clouds of frames taken before the filter's pose history has poses (its heading is not known
+// yet) are held in `hold` (map.hold_seconds, map.hold_bytes) and mapped at their own stamps
+// once it has, at the smoothed poses the estimation stage puts there (EstimationStage), each
+// into an empty cloud ring so that live clouds keep their place.
 // It keeps only the newest frame when it falls behind: drivers never wait for it.
 class PerceptionStage {
  public:
@@ -58,8 +70,8 @@ class PerceptionStage {
                   common::SpscRing<common::ImageFrame>& colour,
                   common::SpscRing<common::ImageFrame>* depth_frames,
                   common::SpscRing<common::PointScan>* scans, const SharedPoseHistory& poses,
-                  common::SpscRing<common::LabeledCloud>& clouds,
-                  double max_position_sigma_m = 0.0);
+                  common::SpscRing<common::LabeledCloud>& clouds, double max_position_sigma_m = 0.0,
+                  HoldBuffer hold = HoldBuffer(0.0, 0));
   ~PerceptionStage();
   PerceptionStage(const PerceptionStage&) = delete;
   PerceptionStage& operator=(const PerceptionStage&) = delete;
@@ -110,6 +122,9 @@ class PerceptionStage {
   perception::Segmentation segment(const common::ImageFrame& colour, const cv::Mat& image);
   void queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp, std::uint32_t sequence);
   bool pose_clouds();
+  bool release_held();
+  void hand_over(common::LabeledCloud cloud);
+  void count_hold_drops(std::uint64_t n);
   bool too_uncertain(const estimation::StampedPose& pose);
   void reject(const std::string& frame, const std::string& why);
   void share_stats();
@@ -136,6 +151,10 @@ class PerceptionStage {
   std::deque<common::ImageFrame> depth_pending_;
   std::deque<common::PointScan> scan_pending_;
   std::deque<BodyCloud> unposed_;
+  HoldBuffer hold_;
+  std::deque<common::LabeledCloud> held_posed_;  // held clouds posed, waiting for the ring
+  std::uint64_t hold_dropped_seen_ = 0;          // hold_.dropped() already counted
+  bool live_handed_over_ = false;                // held clouds go after the first live one
   common::LatencyWindow latency_;
   common::LatencyWindow segment_time_;
   common::LatencyWindow points_time_;

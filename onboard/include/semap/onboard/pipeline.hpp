@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -144,6 +145,9 @@ class Pipeline {
   TapFanout taps_;  // the DDS outputs' taps (attach_tap); outlives their writers
   // Declared in the order they may be destroyed last: the publisher reads the mapping stage.
   std::unique_ptr<MappingStage> mapping_;
+  // For the log line of the first blocks in the map; the flag only on the mapping thread.
+  std::chrono::steady_clock::time_point constructed_ = std::chrono::steady_clock::now();
+  bool first_blocks_logged_ = false;
   std::unique_ptr<DdsOutputs> dds_;
   std::unique_ptr<PerceptionStage> perception_;
   std::unique_ptr<EstimationStage> estimation_;

@@ -32,9 +32,18 @@ class SharedPoseHistory {
   void clear();
   Lookup at(common::Stamp stamp) const;
 
+  // The smoothed poses of the seconds before the heading was known (EstimationStage), given
+  // once, empty when there are none (no record was kept).
+  void set_smoothed(std::span<const estimation::StampedPose> poses);
+  bool smoothed_given() const;
+  // The pose of a frame held from those seconds: kNoFilter until set_smoothed, then kPosed
+  // inside the smoothed poses and kTooOld outside them.
+  Lookup smoothed_at(common::Stamp stamp) const;
+
  private:
   mutable std::mutex mutex_;
   estimation::PoseHistory history_;
+  std::optional<estimation::PoseHistory> smoothed_;
 };
 
 }  // namespace semap::onboard
