@@ -58,10 +58,11 @@ struct PerceptionStageStats {
 // position sigma is above `max_position_sigma_m` (> 0; map.max_position_sigma_m): such a cloud
 // is dropped and counted (uncertain_pose), so mapping pauses while the filter is unsure where
 // it is and resumes when it knows again.
-// Clouds of frames taken before the filter's pose history has poses (its heading is not known
-// yet) are held in `hold` (map.hold_seconds, map.hold_bytes) and mapped at their own stamps
-// once it has, at the smoothed poses the estimation stage puts there (EstimationStage), each
-// into an empty cloud ring so that live clouds keep their place.
+// Clouds without a pose before the estimation stage has given the smoothed poses of the
+// seconds before the heading was known (SharedPoseHistory::set_smoothed) are held in `hold`
+// (map.hold_seconds, map.hold_bytes) and then mapped at the smoothed poses of their own
+// stamps, one at a time into an empty cloud ring after the first live cloud, so that live
+// clouds keep their place.
 // It keeps only the newest frame when it falls behind: drivers never wait for it.
 class PerceptionStage {
  public:
