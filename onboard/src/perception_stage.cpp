@@ -161,6 +161,7 @@ void PerceptionStage::run(std::stop_token stop) {
   figures.unpaired += lidar ? scan_pending_.size() : colour_pending_.size();
   figures.partner_unused += lidar ? colour_pending_.size() : depth_pending_.size();
   figures.without_pose += unposed_.size();
+  drain_held_posed();
   count_hold_drops(hold_.size() + held_posed_.size());
   colour_pending_.clear();
   depth_pending_.clear();
@@ -415,6 +416,23 @@ bool PerceptionStage::release_held() {
   }
   figures.holding = hold_.size() + held_posed_.size();
   return any;
+}
+
+// At the stop, the held clouds already posed still go to the mapping stage, which stops after
+// this one, as it empties the ring: a run then maps the same clouds however its end falls
+// (a replay as its recording). A mapping stage that takes none for a second has stalled: the
+// rest are counted as dropped.
+void PerceptionStage::drain_held_posed() {
+  auto waited_since = std::chrono::steady_clock::now();
+  while (!held_posed_.empty() && seconds_since(waited_since) < 1.0) {
+    if (!cloud_ring_.empty()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      continue;
+    }
+    hand_over(std::move(held_posed_.front()));
+    held_posed_.pop_front();
+    waited_since = std::chrono::steady_clock::now();
+  }
 }
 
 // A posed cloud (world frame) to the mapping stage.

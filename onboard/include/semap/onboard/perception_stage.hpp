@@ -124,6 +124,7 @@ class PerceptionStage {
   void queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp, std::uint32_t sequence);
   bool pose_clouds();
   bool release_held();
+  void drain_held_posed();
   void hand_over(common::LabeledCloud cloud);
   void count_hold_drops(std::uint64_t n);
   bool too_uncertain(const estimation::StampedPose& pose);
