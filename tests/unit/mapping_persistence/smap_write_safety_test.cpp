@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -123,24 +124,43 @@ TEST_F(SmapWrite, FailedWriteLeavesOldFileAndNoTemporary) {
 // A writer rewriting the map in a loop is SIGKILLed at random moments. Each time the file must
 // be one of the complete maps; a kill inside write_file_atomically leaves its temporary
 // `.map.smap.XXXXXX` (nothing in the dying process can remove it), which the next write_smap
-// removes once it is unlocked and stale.
+// removes once it is unlocked and stale. The writer loops over the encoded maps, as write_smap
+// does after encoding, so that most kills land in the file's write (encoding touches no file).
 TEST_F(SmapWrite, KilledWriterLeavesACompleteFile) {
   const LayeredMap old_map = testing::random_logodds_map(22);
   const std::vector<LayeredMap> maps = {big_map(9, 3.0f), big_map(8, 4.0f)};
   std::vector<std::vector<std::uint8_t>> allowed = {encode_smap(old_map)};
   for (const auto& m : maps) allowed.push_back(encode_smap(m));
+  // Kills fall anywhere in two writes' time (a write is slow under a sanitizer).
+  const auto start = std::chrono::steady_clock::now();
+  write_file_atomically(path_, allowed[1]);
+  const auto one_write = std::chrono::duration_cast<std::chrono::microseconds>(
+      std::chrono::steady_clock::now() - start);
   std::mt19937 rng(20);
-  std::uniform_int_distribution<int> delay_us(0, 60000);
+  std::uniform_int_distribution<std::int64_t> delay_us(0, 2 * one_write.count());
   int mid_write = 0;
   constexpr int kRounds = 20;
   for (int round = 0; round < kRounds; ++round) {
     write_smap(path_, old_map);
     ASSERT_THAT(others(dir_, "map.smap"), ::testing::IsEmpty()) << "round " << round;
+    // The child says when its first write is done, so that the random moment falls in its loop
+    // of writes, not in its start-up (slow under a sanitizer on a loaded machine).
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
     const pid_t pid = ::fork();
     if (pid == 0) {
-      for (std::size_t i = 0;; ++i) write_smap(path_, maps[i % maps.size()]);
+      ::close(ready[0]);
+      write_file_atomically(path_, allowed[1]);
+      const char byte = 1;
+      if (::write(ready[1], &byte, 1) != 1) ::_exit(3);
+      for (std::size_t i = 1;; ++i) write_file_atomically(path_, allowed[1 + i % maps.size()]);
     }
     ASSERT_GT(pid, 0);
+    ::close(ready[1]);
+    char byte = 0;
+    const ssize_t started = ::read(ready[0], &byte, 1);
+    ::close(ready[0]);
+    ASSERT_EQ(started, 1) << "round " << round << ": the writer died before its first write";
     std::this_thread::sleep_for(std::chrono::microseconds(delay_us(rng)));
     ::kill(pid, SIGKILL);
     int status = 0;
@@ -164,7 +184,8 @@ TEST_F(SmapWrite, KilledWriterLeavesACompleteFile) {
         << "round " << round << ": the next write left the dead writer's temporary";
     EXPECT_EQ(file_bytes(path_), allowed[0]);
   }
-  std::printf("%d of %d kills landed inside a write\n", mid_write, kRounds);
+  std::printf("%d of %d kills landed inside a write (%.1f ms a write)\n", mid_write, kRounds,
+              1e-3 * static_cast<double>(one_write.count()));
   EXPECT_GT(mid_write, 0) << "no kill hit a write: the test exercised nothing";
 }
 
