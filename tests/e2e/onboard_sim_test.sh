@@ -130,9 +130,10 @@ rmse=$(json pose_rmse_m)
 at_most "$rmse" 0.5 || fail "pose RMSE $rmse m > 0.5 m"
 mapped=$(json frames_mapped) captured=$(json frames_captured)
 # The camera runs at 15 Hz (the rig renders 13 to 15 frames a second on the 2-core test
-# machine; fewer than 10 means it is starved); frames before the filter's heading settles get no
-# pose (or one certain enough). Every frame rendered reaches perception, and every frame after that must reach the map
-# (a few may be passed over).
+# machine; fewer than 10 means it is starved); frames before the filter's heading settles are
+# held and mapped at smoothed poses (map.hold_seconds), those the hold dropped count "without a
+# pose", as do frames with no pose at all. Every frame rendered reaches perception, and every
+# frame with a pose must reach the map (a few may be passed over).
 unposed=$(sed -n 's/^perception *: .* \([0-9]*\) without a pose.*/\1/p' "$work/onboard.log")
 # Frames posed while the filter's position sigma was above map.max_position_sigma_m (its first
 # seconds) are not mapped either.
