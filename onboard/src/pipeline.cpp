@@ -76,7 +76,7 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
           make_segmenter(config_.segmenter, config_.map.params.num_classes), colour_ring_,
           source == DepthSource::kAligned ? &depth_ring_ : nullptr,
           source == DepthSource::kLidar ? &scan_ring_ : nullptr, poses_, cloud_ring_,
-          config_.map.max_position_sigma_m);
+          config_.map.max_position_sigma_m, config_.perception);
       log->info("perception: {}", perception_->describe());
     } catch (const std::exception& e) {
       log->error("perception disabled, running without a map: {}", e.what());
