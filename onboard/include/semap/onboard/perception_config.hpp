@@ -81,7 +81,7 @@ struct SegmentRateConfig {
   // segmentation, carried to it by the poses. Aligned depth only.
   bool carry_labels = false;
   double segment_hz = 0.0;       // 0: as often as the network can
-  double max_label_age_s = 1.0;  // frames whose newest segmentation is older are not mapped
+  double max_label_age_s = 2.0;  // frames whose newest segmentation is older are not mapped
   perception::CarryOptions carry;
 };
 
