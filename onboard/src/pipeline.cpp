@@ -224,8 +224,8 @@ bool Pipeline::has_taken(const HandedOver& handed) const {
   if (e.imu_samples < handed.imu_samples || e.gnss_fixes < handed.gnss_fixes) return false;
   if (!perception_) return true;
   const auto p = perception_->stats();
-  const auto done =
-      p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose + p.uncertain_pose;
+  const auto done = p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose +
+                    p.uncertain_pose + p.labels_too_old;
   // One cloud in the ring (capacity depth.ring >= 2) and none dropped: the same map as when
   // waiting for each insert, at the pace of the slower stage instead of the sum of both.
   return p.frames == handed.frames && done == p.frames &&
