@@ -9,6 +9,8 @@
 // scene where they are absent): the network's forward pass on an image resized to the card's
 // input, the whole segment() of a 640x480 frame (p50/p99 over --frames), and the 15 Hz steady
 // state of the same stages with the card's segmenter, then a table of both.
+// --carry-labels runs the steady state with the network on its own thread and labels carried
+// between its segmentations (perception.carry_labels; --segment-hz: perception.segment_hz).
 //
 // The last line is parsed by scripts (in --model-card mode: CARD's steady state):
 //   steady state: F frames/s mapped, latency p50 A ms p99 B ms, cpu C cores
@@ -69,6 +71,8 @@ struct Options {
   std::filesystem::path model_card;  // a trained network instead of the synthetic one
   std::filesystem::path baseline = SEMAP_SOURCE_DIR "/models/semap-seg.yaml";
   std::filesystem::path redwood = SEMAP_SHARED_DATA_DIR "/real/redwood";
+  bool carry_labels = false;
+  double segment_hz = 0.0;
 };
 
 void row(const std::string& what, const bench::Spread& s) {
@@ -178,9 +182,9 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
   onboard::SegmenterConfig seg;
   seg.kind = onboard::SegmenterConfig::Kind::kDnn;
   seg.model_card = card;
-  onboard::PerceptionStage perception(config.camera, config.depth,
-                                      onboard::make_segmenter(seg, config.map.params.num_classes),
-                                      colour_ring, &depth_ring, nullptr, poses, cloud_ring);
+  onboard::PerceptionStage perception(
+      config.camera, config.depth, onboard::make_segmenter(seg, config.map.params.num_classes),
+      colour_ring, &depth_ring, nullptr, poses, cloud_ring, 0.0, config.perception);
   onboard::MappingStage mapping(config.map, cloud_ring, nullptr, {});
 
   // The estimation stage's part: filter poses at 200 Hz, stamped now.
@@ -223,7 +227,9 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
 
   const auto drops = [](const auto& ring) { return ring.counters().drops(); };
   // Frames passed over or without a depth partner never reach the segmenter.
-  const std::uint64_t segmented = p.frames - std::min(p.frames, p.skipped + p.unpaired);
+  const std::uint64_t segmented = config.perception.carry_labels
+                                      ? p.segmented
+                                      : p.frames - std::min(p.frames, p.skipped + p.unpaired);
   const std::uint64_t ring_drops = drops(colour_ring) + drops(cloud_ring);
   std::printf("steady state over %.1f s (%u frames pushed at %.0f Hz, stride %d):\n", wall, frames,
               kCameraHz, config.depth.points.stride);
@@ -235,6 +241,13 @@ SteadyState steady_state(const Options& o, const onboard::OnboardConfig& config,
       1e3 * p.segment_seconds_max,
       p.clouds ? static_cast<double>(p.points) / static_cast<double>(p.clouds) : 0.0,
       perception.latency().percentiles().p50_ms, perception.latency().percentiles().p99_ms);
+  if (config.perception.carry_labels) {
+    std::printf(
+        "  network on its own thread: %lu frames segmented (%.1f Hz), %lu clouds with carried "
+        "labels, %lu frames with labels too old, %lu failures, %lu pixels occluded\n",
+        p.segmented, static_cast<double>(p.segmented) / wall, p.carried, p.labels_too_old,
+        p.segment_failures, p.dropped.occluded);
+  }
   std::printf("  mapping: %lu scans, insert mean %.1f ms max %.1f ms, map %zu blocks %zu cells\n",
               m.scans, m.scans ? 1e3 * m.insert_seconds_total / static_cast<double>(m.scans) : 0.0,
               1e3 * m.insert_seconds_max, m.map.blocks, m.map.cells);
@@ -417,6 +430,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--redwood", o.redwood, "Redwood RGB-D frames for --model-card")
       ->capture_default_str();
+  app.add_flag("--carry-labels", o.carry_labels,
+               "steady state: the network on its own thread, labels carried between");
+  app.add_option("--segment-hz", o.segment_hz, "with --carry-labels: at most this rate (0: any)")
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
   if (!o.model_card.empty() && app.count("--seconds") == 0) o.seconds = 10.0;
   int infer_w = 0, infer_h = 0;
@@ -442,6 +459,12 @@ int main(int argc, char** argv) {
   config.map.params.ds_res = 0.2f;
   config.map.params.max_range = 20.0f;
   config.map.threads = o.threads;
+  config.perception.carry_labels = o.carry_labels;
+  config.perception.segment_hz = o.segment_hz;
+  // The steady state cycles still frames while its poses drive a circle: the depth of a carried
+  // pixel never agrees with the segmented frame's, and the occlusion test would drop them all.
+  // Opened, each cloud keeps the points it would have had, and the cost is the one measured.
+  config.perception.carry.depth_tolerance_m = 1e3f;
 
   const TempDir dir;
   const auto scene = bench::render_scene(config.camera, config.depth.depth_scale);

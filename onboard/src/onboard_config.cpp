@@ -166,6 +166,25 @@ void read_segmenter(const ConfigSection& s, SegmenterConfig& seg) {
   s.finish();
 }
 
+void read_segment_rate(const ConfigSection& s, const DepthConfig& depth, SegmentRateConfig& rate) {
+  rate.carry_labels = s.get<bool>("carry_labels", rate.carry_labels);
+  if (rate.carry_labels && depth.source != DepthSource::kAligned) {
+    s.reject("carry_labels", "needs aligned depth (depth.source: aligned)");
+  }
+  for (const char* key :
+       {"segment_hz", "max_label_age_s", "depth_tolerance_m", "depth_tolerance_ratio"}) {
+    if (s.has(key) && !rate.carry_labels) s.reject(key, "applies with carry_labels: true only");
+  }
+  rate.segment_hz = s.get_in_range("segment_hz", rate.segment_hz, 0.0, 1000.0);
+  rate.max_label_age_s = s.get_in_range("max_label_age_s", rate.max_label_age_s, 0.01, 60.0);
+  auto& carry = rate.carry;
+  carry.depth_tolerance_m =
+      static_cast<float>(s.get_in_range("depth_tolerance_m", carry.depth_tolerance_m, 0.0, 10.0));
+  carry.depth_tolerance_ratio = static_cast<float>(
+      s.get_in_range("depth_tolerance_ratio", carry.depth_tolerance_ratio, 0.0, 1.0));
+  s.finish();
+}
+
 void read_dds(const ConfigSection& s, DdsConfig& dds) {
   dds.enabled = s.get<bool>("enabled", true);
   if (s.has("config")) {
@@ -219,6 +238,7 @@ OnboardConfig load_onboard_config(const std::filesystem::path& path, const RigKe
   read_camera(root.section_or_empty("camera"), c.camera);
   read_depth(root.section_or_empty("depth"), c.camera, c.depth);
   read_segmenter(root.section_or_empty("segmenter"), c.segmenter);
+  read_segment_rate(root.section_or_empty("perception"), c.depth, c.perception);
   c.estimator = estimation::load_estimator_config(root.section_or_empty("estimator"));
   const auto map = root.section_or_empty("map");
   c.map.params = mapping::map_params_from_config(map, c.map.params);

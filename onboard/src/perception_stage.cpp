@@ -9,6 +9,7 @@
 #include "semap/mapping/cloud_transform.hpp"
 #include "semap/perception/depth_cloud.hpp"
 #include "semap/perception/geometry_segmenter.hpp"
+#include "semap/perception/label_carrying.hpp"
 #include "semap/perception/lidar_projection.hpp"
 #include "semap/perception/stereo_depth.hpp"
 
@@ -86,17 +87,16 @@ bool process_newest_pair(std::deque<Lead>& leads, std::deque<Partner>& partners,
 
 }  // namespace
 
-PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& depth,
-                                 std::unique_ptr<perception::Segmenter> segmenter,
-                                 common::SpscRing<common::ImageFrame>& colour,
-                                 common::SpscRing<common::ImageFrame>* depth_frames,
-                                 common::SpscRing<common::PointScan>* scans,
-                                 const SharedPoseHistory& poses,
-                                 common::SpscRing<common::LabeledCloud>& clouds,
-                                 double max_position_sigma_m, HoldBuffer hold)
+PerceptionStage::PerceptionStage(
+    const CameraConfig& camera, const DepthConfig& depth,
+    std::unique_ptr<perception::Segmenter> segmenter, common::SpscRing<common::ImageFrame>& colour,
+    common::SpscRing<common::ImageFrame>* depth_frames, common::SpscRing<common::PointScan>* scans,
+    const SharedPoseHistory& poses, common::SpscRing<common::LabeledCloud>& clouds,
+    double max_position_sigma_m, const SegmentRateConfig& rate, HoldBuffer hold)
     : camera_(camera),
       depth_(depth),
       segmenter_(std::move(segmenter)),
+      rate_(rate),
       colour_ring_(colour),
       depth_ring_(depth_frames),
       scan_ring_(scans),
@@ -106,6 +106,12 @@ PerceptionStage::PerceptionStage(const CameraConfig& camera, const DepthConfig& 
       body_from_optical_(camera.body_from_optical()),
       hold_(std::move(hold)) {
   if (!segmenter_) throw std::invalid_argument("perception stage: no segmenter");
+  if (rate_.carry_labels) {
+    if (depth_.source != DepthSource::kAligned) {
+      throw std::invalid_argument("perception stage: carrying labels needs aligned depth");
+    }
+    network_ = std::make_unique<perception::AsyncSegmenter>(std::move(segmenter_));
+  }
   if (depth_.source == DepthSource::kAligned && !depth_ring_) {
     throw std::invalid_argument("perception stage: aligned depth needs a depth frame ring");
   }
@@ -145,6 +151,12 @@ std::string PerceptionStage::describe() const {
     case DepthSource::kAligned:
       break;
   }
+  if (network_) {
+    return network_->describe() + " on its own thread (" +
+           (rate_.segment_hz > 0.0 ? "at most " + std::to_string(rate_.segment_hz) + " Hz"
+                                   : std::string("as often as it can")) +
+           "), labels carried to the aligned Z16 depth frames between";
+  }
   return segmenter_->describe() + ", aligned Z16 depth";
 }
 
@@ -175,6 +187,7 @@ void PerceptionStage::run(std::stop_token stop) {
 
 bool PerceptionStage::step() {
   bool worked = take_frames();
+  worked = take_segmentation() || worked;
   worked = process_next() || worked;
   worked = pose_clouds() || worked;
   worked = release_held() || worked;
@@ -275,12 +288,75 @@ perception::Segmentation PerceptionStage::segment(const common::ImageFrame& colo
                                                   const cv::Mat& image) {
   const auto t0 = std::chrono::steady_clock::now();
   perception::Segmentation segmentation = segmenter_->segment(image);
-  const double seconds = seconds_since(t0);
+  count_segmentation(seconds_since(t0));
+  if (observer_) observer_(colour.sequence, colour.stamp, image, segmentation);
+  return segmentation;
+}
+
+void PerceptionStage::count_segmentation(double seconds) {
   segment_time_.record(seconds);
   stage_.figures().segment_seconds_total += seconds;
   stage_.figures().segment_seconds_max = std::max(stage_.figures().segment_seconds_max, seconds);
-  if (observer_) observer_(colour.sequence, colour.stamp, image, segmentation);
-  return segmentation;
+}
+
+// Carrying labels: the network gets the frame unless segment_hz holds it back, and the frame
+// waits for its pose with its depth, to be labelled then from the newest segmentation.
+void PerceptionStage::hand_to_network(const common::ImageFrame& colour, const cv::Mat& image,
+                                      const cv::Mat& depth_m) {
+  const double interval = rate_.segment_hz > 0.0 ? 1.0 / rate_.segment_hz : 0.0;
+  if (!last_handed_ || common::seconds_between(colour.stamp, *last_handed_) >= interval) {
+    network_->submit({image, depth_m, colour.stamp, colour.sequence, {}, 0.0});
+    last_handed_ = colour.stamp;
+  }
+  queue_for_pose(common::LabeledCloud{}, colour.stamp, colour.sequence);
+  unposed_.back().unlabelled_depth_m = depth_m;
+}
+
+bool PerceptionStage::take_segmentation() {
+  if (!network_) return false;
+  auto& figures = stage_.figures();
+  figures.segment_failures = network_->failures();
+  std::optional<perception::SegmentJob> job = network_->take();
+  if (!job) return false;
+  ++figures.segmented;
+  count_segmentation(job->seconds);
+  if (observer_) observer_(job->sequence, job->stamp, job->bgr, job->segmentation);
+  newest_ = std::move(job);
+  return true;
+}
+
+// Labels a posed depth frame from the newest segmentation, carried to it by the poses at the
+// two stamps; waits while the segmented frame's pose is still to come.
+PerceptionStage::Carried PerceptionStage::carry_labels(BodyCloud& frame,
+                                                       const estimation::StampedPose& pose) {
+  auto& figures = stage_.figures();
+  const common::Stamp stamp = frame.cloud.stamp;
+  if (!newest_ ||
+      std::abs(common::seconds_between(stamp, newest_->stamp)) > rate_.max_label_age_s) {
+    ++figures.labels_too_old;
+    return Carried::kDropped;
+  }
+  const auto segmented = poses_.at(newest_->stamp);
+  if (segmented.status == SharedPoseHistory::Status::kPending) return Carried::kWaitForPose;
+  if (segmented.status != SharedPoseHistory::Status::kPosed) {
+    ++figures.without_pose;
+    return Carried::kDropped;
+  }
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    frame.cloud = perception::cloud_from_carried_labels(
+        frame.unlabelled_depth_m, newest_->segmentation, newest_->depth_m,
+        perception::segmented_from_current(segmented.pose.world_from_body(), pose.world_from_body(),
+                                           body_from_optical_),
+        camera_.intrinsics, body_from_optical_, depth_.points, rate_.carry, figures.dropped);
+    points_time_.record(seconds_since(t0));
+  } catch (const std::exception& e) {
+    reject("frame " + std::to_string(frame.sequence), e.what());
+    return Carried::kDropped;
+  }
+  frame.cloud.stamp = stamp;
+  if (newest_->sequence != frame.sequence) ++figures.carried;
+  return Carried::kLabelled;
 }
 
 void PerceptionStage::process(const common::ImageFrame& colour, const common::ImageFrame* depth) {
@@ -304,6 +380,7 @@ void PerceptionStage::process(const common::ImageFrame& colour, const common::Im
       if (z16.empty()) return reject(frame_name(*depth), "truncated depth frame");
       depth_m = perception::depth_metres(z16, depth_.depth_scale);
     }
+    if (network_) return hand_to_network(colour, image, depth_m);
     const perception::Segmentation segmentation = segment(colour, image);
     const auto t0 = std::chrono::steady_clock::now();
     common::LabeledCloud cloud =
@@ -349,7 +426,7 @@ void PerceptionStage::queue_for_pose(common::LabeledCloud body_cloud, common::St
     unposed_.pop_front();  // the filter has stalled; keep the newest
     ++stage_.figures().without_pose;
   }
-  unposed_.push_back(BodyCloud{std::move(body_cloud), sequence});
+  unposed_.push_back(BodyCloud{std::move(body_cloud), sequence, {}});
 }
 
 bool PerceptionStage::pose_clouds() {
@@ -358,10 +435,11 @@ bool PerceptionStage::pose_clouds() {
   while (!unposed_.empty()) {
     const auto lookup = poses_.at(unposed_.front().cloud.stamp);
     if (lookup.status == SharedPoseHistory::Status::kPending) break;
-    any = true;
-    // Before the heading is known, and until the smoothed poses of those seconds are given.
+    // Before the heading is known, and until the smoothed poses of those seconds are given. A
+    // frame waiting for carried labels is not held: its segmentation's pose is not known either.
     if (lookup.status != SharedPoseHistory::Status::kPosed && hold_.enabled() &&
-        !poses_.smoothed_given()) {
+        !poses_.smoothed_given() && unposed_.front().unlabelled_depth_m.empty()) {
+      any = true;
       ++figures.held;
       hold_.push(std::move(unposed_.front().cloud), unposed_.front().sequence);
       unposed_.pop_front();
@@ -373,12 +451,24 @@ bool PerceptionStage::pose_clouds() {
     if (lookup.status != SharedPoseHistory::Status::kPosed) {
       ++figures.without_pose;
       unposed_.pop_front();
+      any = true;
       continue;
     }
     if (too_uncertain(lookup.pose)) {
       unposed_.pop_front();
+      any = true;
       continue;
     }
+    if (!unposed_.front().unlabelled_depth_m.empty()) {
+      const Carried carried = carry_labels(unposed_.front(), lookup.pose);
+      if (carried == Carried::kWaitForPose) break;
+      if (carried == Carried::kDropped) {
+        unposed_.pop_front();
+        any = true;
+        continue;
+      }
+    }
+    any = true;
     common::LabeledCloud cloud =
         mapping::transform_cloud(std::move(unposed_.front().cloud), lookup.pose.world_from_body());
     unposed_.pop_front();

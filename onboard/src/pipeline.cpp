@@ -76,7 +76,7 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
           make_segmenter(config_.segmenter, config_.map.params.num_classes), colour_ring_,
           source == DepthSource::kAligned ? &depth_ring_ : nullptr,
           source == DepthSource::kLidar ? &scan_ring_ : nullptr, poses_, cloud_ring_,
-          config_.map.max_position_sigma_m,
+          config_.map.max_position_sigma_m, config_.perception,
           HoldBuffer(config_.map.hold_seconds, config_.map.hold_bytes));
       log->info("perception: {}", perception_->describe());
     } catch (const std::exception& e) {
@@ -242,7 +242,7 @@ bool Pipeline::has_taken(const HandedOver& handed) const {
   if (!perception_) return true;
   const auto p = perception_->stats();
   const auto done = p.clouds + p.skipped + p.unpaired + p.bad_frames + p.without_pose +
-                    p.uncertain_pose + p.holding;
+                    p.uncertain_pose + p.holding + p.labels_too_old;
   // One cloud in the ring (capacity depth.ring >= 2) and none dropped: the same map as when
   // waiting for each insert, at the pace of the slower stage instead of the sum of both.
   return p.frames == handed.frames && done == p.frames &&

@@ -30,11 +30,12 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
   };
   if (perception) {
     // Colour frames (or a LiDAR rig's scans) lost anywhere before the map: in the driver's
-    // ring, passed over, unpaired, unreadable, without a pose or posed too uncertainly.
+    // ring, passed over, unpaired, unreadable, without a pose, posed too uncertainly or
+    // without a recent enough segmentation to carry labels from.
     const auto p = perception->stats();
     figures.push_back({"perception", p.clouds, perception->queue_depth(),
                        drops(r.colour) + drops(r.scans) + p.skipped + p.unpaired + p.bad_frames +
-                           p.without_pose + p.uncertain_pose,
+                           p.without_pose + p.uncertain_pose + p.labels_too_old,
                        perception->latency().percentiles()});
   }
   return figures;

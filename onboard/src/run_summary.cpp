@@ -21,7 +21,9 @@ void perception_summary(const PerceptionStage& perception, std::vector<std::stri
                   "{:.1f} ms max {:.1f} ms; latency p50 {:.1f} ms p99 {:.1f} ms",
                   p.frames, p.clouds, p.points, p.skipped, p.unpaired, p.bad_frames, p.without_pose,
                   p.uncertain_pose,
-                  p.clouds ? 1e3 * p.segment_seconds_total / static_cast<double>(p.frames) : 0.0,
+                  p.clouds ? 1e3 * p.segment_seconds_total /
+                                 static_cast<double>(p.segmented ? p.segmented : p.frames)
+                           : 0.0,
                   1e3 * p.segment_seconds_max, static_cast<double>(lat.p50_ms),
                   static_cast<double>(lat.p99_ms)));
   if (p.held > 0) {
@@ -33,6 +35,14 @@ void perception_summary(const PerceptionStage& perception, std::vector<std::stri
   lines.push_back(fmt::format(
       "pixels dropped   : {} no depth, {} out of range, {} no label, {} low confidence",
       p.dropped.no_depth, p.dropped.out_of_range, p.dropped.no_label, p.dropped.low_confidence));
+  if (p.segmented + p.labels_too_old + p.segment_failures > 0) {  // perception.carry_labels
+    lines.push_back(fmt::format(
+        "labels carried   : {} frames segmented ({} failed), {} clouds with carried labels, {} "
+        "frames with labels too old; pixels without a label: {} outside the segmented image, {} "
+        "occluded",
+        p.segmented, p.segment_failures, p.carried, p.labels_too_old, p.dropped.out_of_image,
+        p.dropped.occluded));
+  }
 }
 
 void mapping_summary(const MappingStageStats& map, const std::filesystem::path& checkpoint_path,

@@ -192,6 +192,20 @@ TEST(OnboardConfig, MapHoldKeys) {
   EXPECT_NE(sigma.find("map.hold_heading_sigma_deg"), std::string::npos) << sigma;
 }
 
+TEST(OnboardConfig, PerceptionCarriesLabelsWhenAsked) {
+  EXPECT_FALSE(load(kConfigDir / "sim.yaml").perception.carry_labels);
+  const auto path = edited_sim("estimator:\n",
+                               "perception:\n  carry_labels: true\n  segment_hz: 3\n"
+                               "  max_label_age_s: 0.7\n  depth_tolerance_m: 0.2\nestimator:\n");
+  const auto c = load(path);
+  std::filesystem::remove(path);
+  EXPECT_TRUE(c.perception.carry_labels);
+  EXPECT_DOUBLE_EQ(c.perception.segment_hz, 3.0);
+  EXPECT_DOUBLE_EQ(c.perception.max_label_age_s, 0.7);
+  EXPECT_FLOAT_EQ(c.perception.carry.depth_tolerance_m, 0.2f);
+  EXPECT_FLOAT_EQ(c.perception.carry.depth_tolerance_ratio, 0.05f);
+}
+
 TEST(OnboardConfig, BadPerceptionSectionsNameTheKey) {
   EXPECT_NE(error_of(edited_sim("fov_deg: 90", "fov_deg: 90\n  ring: 6"))
                 .find("camera.ring': 6 is not a power of two"),
@@ -276,6 +290,13 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
       {"  source: aligned\n  depth_scale: 0.001",
        "  source: stereo\n  calibration: config/missing-calibration.yaml", "depth.calibration",
        "missing-calibration.yaml"},
+      {"estimator:\n", "perception:\n  segment_hz: 2\nestimator:\n", "perception.segment_hz",
+       "applies with carry_labels: true only"},
+      {"estimator:\n", "perception:\n  carry_labels: true\n  max_label_age_s: 0\nestimator:\n",
+       "perception.max_label_age_s", "out of range"},
+      {"estimator:\n",
+       "perception:\n  carry_labels: true\n  depth_tolerance_ratio: 2\nestimator:\n",
+       "perception.depth_tolerance_ratio", "out of range"},
   };
   for (const Case& c : cases) {
     const auto path = edited_sim(c.replace, c.with);

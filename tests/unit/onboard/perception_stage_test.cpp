@@ -93,7 +93,8 @@ class PerceptionStageTest : public ::testing::Test {
         camera_, depth_,
         std::make_unique<perception::PaletteSegmenter>(perception::cityscapes_palette(), kClasses,
                                                        options),
-        colour_, &depth_ring_, nullptr, poses_, clouds_, max_position_sigma_m, std::move(hold));
+        colour_, &depth_ring_, nullptr, poses_, clouds_, max_position_sigma_m, SegmentRateConfig{},
+        std::move(hold));
   }
 
   void push_pair(double t, std::uint32_t sequence) {

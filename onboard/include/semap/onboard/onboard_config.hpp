@@ -140,6 +140,7 @@ struct OnboardConfig {
   CameraConfig camera;
   DepthConfig depth;
   SegmenterConfig segmenter;
+  SegmentRateConfig perception;
   estimation::EstimatorConfig estimator;
   MappingConfig map;
   std::optional<CostmapConfig> costmap;  // the `costmap:` section; published over DDS

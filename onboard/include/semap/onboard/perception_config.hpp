@@ -6,6 +6,7 @@
 
 #include "semap/drivers/camera_driver.hpp"
 #include "semap/perception/depth_projection.hpp"
+#include "semap/perception/label_carrying.hpp"
 #include "semap/perception/labelled_points.hpp"
 #include "semap/perception/lidar_projection.hpp"
 #include "semap/perception/stereo_depth.hpp"
@@ -69,6 +70,19 @@ struct SegmenterConfig {
   // palette: YAML file; empty = the Cityscapes colours of the simulated world's classes
   std::filesystem::path palette;
   float confidence = 0.9f;  // palette: probability given to the colour's class
+};
+
+// perception: how often the network runs (docs/perception.md, "Networks slower than the
+// camera").
+struct SegmentRateConfig {
+  // false: every frame mapped is segmented first, on the stage's thread (a network that keeps up
+  // with the camera). true: the network runs on its own thread on the newest colour frame, as
+  // often as it can (at most segment_hz), and each depth frame is labelled from the newest
+  // segmentation, carried to it by the poses. Aligned depth only.
+  bool carry_labels = false;
+  double segment_hz = 0.0;       // 0: as often as the network can
+  double max_label_age_s = 2.0;  // frames whose newest segmentation is older are not mapped
+  perception::CarryOptions carry;
 };
 
 }  // namespace semap::onboard

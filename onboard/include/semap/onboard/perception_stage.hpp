@@ -4,6 +4,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "semap/onboard/perception_config.hpp"
 #include "semap/onboard/shared_pose_history.hpp"
 #include "semap/onboard/stage_thread.hpp"
+#include "semap/perception/async_segmenter.hpp"
 #include "semap/perception/labelled_points.hpp"
 #include "semap/perception/segmentation.hpp"
 
@@ -48,6 +50,11 @@ struct PerceptionStageStats {
   perception::DropCounts dropped;  // pixels dropped on the way to points, by reason
   double segment_seconds_total = 0.0;
   double segment_seconds_max = 0.0;
+  // perception.carry_labels: the network on its own thread.
+  std::uint64_t segmented = 0;         // frames it segmented
+  std::uint64_t segment_failures = 0;  // frames it failed on (logged)
+  std::uint64_t carried = 0;           // clouds labelled from an earlier frame's segmentation
+  std::uint64_t labels_too_old = 0;    // no segmentation within perception.max_label_age_s
 };
 
 // Owns the camera's half of the pipeline on its own thread: takes colour frames (and depth
@@ -64,6 +71,10 @@ struct PerceptionStageStats {
 // stamps, one at a time into an empty cloud ring after the first live cloud, so that live
 // clouds keep their place.
 // It keeps only the newest frame when it falls behind: drivers never wait for it.
+// With rate.carry_labels (a network slower than the camera) the network runs on its own thread
+// on the newest colour frame and every depth frame is labelled, once the poses at both stamps
+// are known, from the newest segmentation carried to it (perception/label_carrying.hpp);
+// a frame whose newest segmentation is older than rate.max_label_age_s is not mapped.
 class PerceptionStage {
  public:
   PerceptionStage(const CameraConfig& camera, const DepthConfig& depth,
@@ -72,7 +83,7 @@ class PerceptionStage {
                   common::SpscRing<common::ImageFrame>* depth_frames,
                   common::SpscRing<common::PointScan>* scans, const SharedPoseHistory& poses,
                   common::SpscRing<common::LabeledCloud>& clouds, double max_position_sigma_m = 0.0,
-                  HoldBuffer hold = HoldBuffer(0.0, 0));
+                  const SegmentRateConfig& rate = {}, HoldBuffer hold = HoldBuffer(0.0, 0));
   ~PerceptionStage();
   PerceptionStage(const PerceptionStage&) = delete;
   PerceptionStage& operator=(const PerceptionStage&) = delete;
@@ -112,7 +123,11 @@ class PerceptionStage {
   struct BodyCloud {
     common::LabeledCloud cloud;  // body frame
     std::uint32_t sequence = 0;
+    // Carrying labels: the frame's depth (metres), labelled once it is posed; the cloud holds
+    // only the stamp until then.
+    cv::Mat unlabelled_depth_m;
   };
+  enum class Carried { kLabelled, kWaitForPose, kDropped };
 
   void run(std::stop_token stop);
   bool take_frames();
@@ -121,6 +136,11 @@ class PerceptionStage {
   void process_scan(const common::PointScan& scan, const common::ImageFrame* colour);
   cv::Mat colour_image(const common::ImageFrame& colour);
   perception::Segmentation segment(const common::ImageFrame& colour, const cv::Mat& image);
+  void count_segmentation(double seconds);
+  void hand_to_network(const common::ImageFrame& colour, const cv::Mat& image,
+                       const cv::Mat& depth_m);
+  bool take_segmentation();
+  Carried carry_labels(BodyCloud& frame, const estimation::StampedPose& pose);
   void queue_for_pose(common::LabeledCloud body_cloud, common::Stamp stamp, std::uint32_t sequence);
   bool pose_clouds();
   bool release_held();
@@ -137,6 +157,10 @@ class PerceptionStage {
   SegmentationObserver observer_;
   FrameTap tap_;
   std::unique_ptr<perception::StereoDepth> stereo_;
+  SegmentRateConfig rate_;
+  std::unique_ptr<perception::AsyncSegmenter> network_;  // rate_.carry_labels: owns the segmenter
+  std::optional<perception::SegmentJob> newest_;         // the newest segmentation it gave
+  std::optional<common::Stamp> last_handed_;             // stamp of the last frame handed to it
   common::SpscRing<common::ImageFrame>& colour_ring_;
   common::SpscRing<common::ImageFrame>* depth_ring_;
   common::SpscRing<common::PointScan>* scan_ring_;

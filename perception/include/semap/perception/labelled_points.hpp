@@ -7,14 +7,17 @@ namespace semap::perception {
 // What turning one frame into labelled points dropped, by reason. Every step that drops a
 // pixel or point counts it here; the onboard stage sums them into its health report.
 struct DropCounts {
-  std::uint64_t no_depth = 0;        // no return, invalid disparity, non-finite value
-  std::uint64_t out_of_range = 0;    // beyond max_range
-  std::uint64_t out_of_image = 0;    // LiDAR point behind the camera or outside the image
+  std::uint64_t no_depth = 0;      // no return, invalid disparity, non-finite value
+  std::uint64_t out_of_range = 0;  // beyond max_range
+  // LiDAR point (or carried pixel) behind the camera or outside the (segmented) image
+  std::uint64_t out_of_image = 0;
   std::uint64_t no_label = 0;        // the segmenter gave kNoLabel
   std::uint64_t low_confidence = 0;  // below min_confidence
+  // Carried pixel whose depth the segmented frame saw differently (hidden from it, or moved)
+  std::uint64_t occluded = 0;
 
   std::uint64_t total() const {
-    return no_depth + out_of_range + out_of_image + no_label + low_confidence;
+    return no_depth + out_of_range + out_of_image + no_label + low_confidence + occluded;
   }
   DropCounts& operator+=(const DropCounts& o) {
     no_depth += o.no_depth;
@@ -22,6 +25,7 @@ struct DropCounts {
     out_of_image += o.out_of_image;
     no_label += o.no_label;
     low_confidence += o.low_confidence;
+    occluded += o.occluded;
     return *this;
   }
 };
