@@ -6,7 +6,6 @@
 
 #include "semap/common/logging.hpp"
 #include "semap/drivers/frame_convert.hpp"
-#include "semap/mapping/cloud_transform.hpp"
 #include "semap/perception/depth_cloud.hpp"
 #include "semap/perception/geometry_segmenter.hpp"
 #include "semap/perception/label_carrying.hpp"
