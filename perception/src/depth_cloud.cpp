@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "depth_points.hpp"
 #include "pixel_labeller.hpp"
 
 namespace semap::perception {
@@ -39,24 +40,9 @@ common::LabeledCloud cloud_from_depth(const cv::Mat& depth_m, const Segmentation
   common::LabeledCloud cloud;
   cloud.origin = body_from_optical.translation();
   PixelLabeller labeller(seg, options, cloud);
-  for (int v = 0; v < depth_m.rows; v += options.stride) {
-    const float* row = depth_m.ptr<float>(v);
-    for (int u = 0; u < depth_m.cols; u += options.stride) {
-      const float z = row[u];
-      if (!std::isfinite(z) || z <= 0.0f) {
-        ++drops.no_depth;
-        continue;
-      }
-      // Back-projection of pixel (u, v) at z-depth z, in the optical frame:
-      //   p = z K^-1 [u v 1]^T = z [(u - cx) / fx, (v - cy) / fy, 1]^T          (1)
-      const Eigen::Vector3f p = k.ray(static_cast<float>(u), static_cast<float>(v)) * z;
-      if (p.norm() > options.max_range) {
-        ++drops.out_of_range;
-        continue;
-      }
-      labeller.add(body_from_optical * p, u, v, drops);
-    }
-  }
+  for_each_depth_point(depth_m, k, options, drops, [&](const Eigen::Vector3f& p, int u, int v) {
+    labeller.add(body_from_optical * p, u, v, drops);
+  });
   return cloud;
 }
 

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "depth_points.hpp"
 #include "pixel_labeller.hpp"
 
 namespace semap::perception {
@@ -40,43 +41,30 @@ common::LabeledCloud cloud_from_carried_labels(
   common::LabeledCloud cloud;
   cloud.origin = body_from_optical.translation();
   PixelLabeller labeller(segmented, options, cloud);
-  for (int v = 0; v < depth_m.rows; v += options.stride) {
-    const float* row = depth_m.ptr<float>(v);
-    for (int u = 0; u < depth_m.cols; u += options.stride) {
-      const float z = row[u];
-      if (!std::isfinite(z) || z <= 0.0f) {
-        ++drops.no_depth;
-        continue;
-      }
-      // p = z K^-1 [u v 1]^T in the current optical frame, q = T_st p in the segmented one.
-      const Eigen::Vector3f p = k.ray(static_cast<float>(u), static_cast<float>(v)) * z;
-      if (p.norm() > options.max_range) {
-        ++drops.out_of_range;
-        continue;
-      }
-      const Eigen::Vector3f q = segmented_from_current * p;
-      if (q.z() <= 0.0f) {
-        ++drops.out_of_image;
-        continue;
-      }
-      // The segmented pixel nearest to K q / q_z.
-      const long us = std::lround(k.fx * q.x() / q.z() + k.cx);
-      const long vs = std::lround(k.fy * q.y() / q.z() + k.cy);
-      if (us < 0 || vs < 0 || us >= k.width || vs >= k.height) {
-        ++drops.out_of_image;
-        continue;
-      }
-      const int su = static_cast<int>(us);
-      const int sv = static_cast<int>(vs);
-      const float seen = segmented_depth_m.at<float>(sv, su);
-      const float tolerance = carry.depth_tolerance_m + carry.depth_tolerance_ratio * q.z();
-      if (!(std::abs(seen - q.z()) <= tolerance)) {  // also a missing or non-finite depth
-        ++drops.occluded;
-        continue;
-      }
-      labeller.add(body_from_optical * p, su, sv, drops);
+  // p in the current optical frame, q = T_st p in the segmented one.
+  for_each_depth_point(depth_m, k, options, drops, [&](const Eigen::Vector3f& p, int, int) {
+    const Eigen::Vector3f q = segmented_from_current * p;
+    if (q.z() <= 0.0f) {
+      ++drops.out_of_image;
+      return;
     }
-  }
+    // The segmented pixel nearest to K q / q_z.
+    const long us = std::lround(k.fx * q.x() / q.z() + k.cx);
+    const long vs = std::lround(k.fy * q.y() / q.z() + k.cy);
+    if (us < 0 || vs < 0 || us >= k.width || vs >= k.height) {
+      ++drops.out_of_image;
+      return;
+    }
+    const int su = static_cast<int>(us);
+    const int sv = static_cast<int>(vs);
+    const float seen = segmented_depth_m.at<float>(sv, su);
+    const float tolerance = carry.depth_tolerance_m + carry.depth_tolerance_ratio * q.z();
+    if (!(std::abs(seen - q.z()) <= tolerance)) {  // also a missing or non-finite depth
+      ++drops.occluded;
+      return;
+    }
+    labeller.add(body_from_optical * p, su, sv, drops);
+  });
   return cloud;
 }
 
