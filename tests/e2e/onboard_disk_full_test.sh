@@ -7,7 +7,7 @@
 #           (--record rec.mcap): the recording reaches the limit in a few seconds, the checkpoint
 #           log a few seconds into mapping, and the map saved at SIGTERM does not fit either. The
 #           recording must replay up to its last whole chunk, with no torn chunk at its end.
-#   tmpfs   (root, mount permitted; else skipped with exit 77) the map lives on a 32 MiB tmpfs
+#   tmpfs   (root, mount permitted; else skipped with exit 77) the map lives on a 64 MiB tmpfs
 #           that a filler file leaves 3 MiB of: checkpoints fail with ENOSPC; then the filler
 #           is deleted, writing must resume and the map saved at SIGTERM fits.
 #
@@ -37,12 +37,12 @@ fail() {
 say() { echo "e2e disk full ($mode): $*"; }
 
 if [[ $mode == tmpfs ]]; then
-  if [[ $(id -u) -ne 0 ]] || ! mount -t tmpfs -o size=32m semap-e2e "$disk" 2>/dev/null; then
+  if [[ $(id -u) -ne 0 ]] || ! mount -t tmpfs -o size=64m semap-e2e "$disk" 2>/dev/null; then
     say "skipped: mounting a tmpfs needs root and mount permission"
     exit 77
   fi
   # 3 MiB left for the map: its checkpoint log fills them a few seconds into mapping.
-  fallocate -l 29M "$disk/filler" 2>/dev/null || head -c $((29 * 1024 * 1024)) /dev/zero >"$disk/filler"
+  fallocate -l 61M "$disk/filler" 2>/dev/null || head -c $((61 * 1024 * 1024)) /dev/zero >"$disk/filler"
   errno_text="No space left on device"
 else
   errno_text="File too large"
