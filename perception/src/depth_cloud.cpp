@@ -33,16 +33,13 @@ common::LabeledCloud cloud_from_depth(const cv::Mat& depth_m, const Segmentation
                                 ", " + describe_size("segmentation", seg.labels.size()) + ", " +
                                 describe_size("intrinsics", intrinsics_size) + " differ");
   }
-  if (options.stride < 1) {
-    throw std::invalid_argument("cloud_from_depth: stride must be >= 1, got " +
-                                std::to_string(options.stride));
-  }
   common::LabeledCloud cloud;
   cloud.origin = body_from_optical.translation();
   PixelLabeller labeller(seg, options, cloud);
-  for_each_depth_point(depth_m, k, options, drops, [&](const Eigen::Vector3f& p, int u, int v) {
-    labeller.add(body_from_optical * p, u, v, drops);
-  });
+  for_each_depth_point("cloud_from_depth", depth_m, k, options, drops,
+                       [&](const Eigen::Vector3f& p, int u, int v) {
+                         labeller.add(body_from_optical * p, u, v, drops);
+                       });
   return cloud;
 }
 

@@ -34,37 +34,35 @@ common::LabeledCloud cloud_from_carried_labels(
         describe_size("segmentation", segmented.labels.size()) + ", " +
         describe_size("intrinsics", size) + " differ");
   }
-  if (options.stride < 1) {
-    throw std::invalid_argument("cloud_from_carried_labels: stride must be >= 1, got " +
-                                std::to_string(options.stride));
-  }
   common::LabeledCloud cloud;
   cloud.origin = body_from_optical.translation();
   PixelLabeller labeller(segmented, options, cloud);
   // p in the current optical frame, q = T_st p in the segmented one.
-  for_each_depth_point(depth_m, k, options, drops, [&](const Eigen::Vector3f& p, int, int) {
-    const Eigen::Vector3f q = segmented_from_current * p;
-    if (q.z() <= 0.0f) {
-      ++drops.out_of_image;
-      return;
-    }
-    // The segmented pixel nearest to K q / q_z.
-    const long us = std::lround(k.fx * q.x() / q.z() + k.cx);
-    const long vs = std::lround(k.fy * q.y() / q.z() + k.cy);
-    if (us < 0 || vs < 0 || us >= k.width || vs >= k.height) {
-      ++drops.out_of_image;
-      return;
-    }
-    const int su = static_cast<int>(us);
-    const int sv = static_cast<int>(vs);
-    const float seen = segmented_depth_m.at<float>(sv, su);
-    const float tolerance = carry.depth_tolerance_m + carry.depth_tolerance_ratio * q.z();
-    if (!(std::abs(seen - q.z()) <= tolerance)) {  // also a missing or non-finite depth
-      ++drops.occluded;
-      return;
-    }
-    labeller.add(body_from_optical * p, su, sv, drops);
-  });
+  for_each_depth_point(
+      "cloud_from_carried_labels", depth_m, k, options, drops,
+      [&](const Eigen::Vector3f& p, int, int) {
+        const Eigen::Vector3f q = segmented_from_current * p;
+        if (q.z() <= 0.0f) {
+          ++drops.out_of_image;
+          return;
+        }
+        // The segmented pixel nearest to K q / q_z.
+        const long us = std::lround(k.fx * q.x() / q.z() + k.cx);
+        const long vs = std::lround(k.fy * q.y() / q.z() + k.cy);
+        if (us < 0 || vs < 0 || us >= k.width || vs >= k.height) {
+          ++drops.out_of_image;
+          return;
+        }
+        const int su = static_cast<int>(us);
+        const int sv = static_cast<int>(vs);
+        const float seen = segmented_depth_m.at<float>(sv, su);
+        const float tolerance = carry.depth_tolerance_m + carry.depth_tolerance_ratio * q.z();
+        if (!(std::abs(seen - q.z()) <= tolerance)) {  // also a missing or non-finite depth
+          ++drops.occluded;
+          return;
+        }
+        labeller.add(body_from_optical * p, su, sv, drops);
+      });
   return cloud;
 }
 
