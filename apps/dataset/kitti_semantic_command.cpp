@@ -31,6 +31,8 @@ struct SemanticOptions {
   std::size_t first = 0;
   std::size_t last = 0;
   std::size_t query_lag = 10;
+  double memory_radius = 0.0;
+  std::string page_dir;
   double progress_seconds = 5.0;
   MapOptions map;
 };
@@ -74,8 +76,11 @@ void print_result(const map_io::KittiSemanticResult& r, double wall_seconds) {
     }
   }
   for (const auto& map : r.maps) {
-    std::printf("map %s blocks %zu cells %zu observed_cells %zu bytes %zu\n", row_name(map.method),
-                map.stats.blocks, map.stats.cells, map.stats.observed_cells, map.stats.bytes);
+    std::printf(
+        "map %s blocks %zu cells %zu observed_cells %zu bytes %zu paged_out %llu paged_in %llu\n",
+        row_name(map.method), map.stats.blocks, map.stats.cells, map.stats.observed_cells,
+        map.stats.bytes, static_cast<unsigned long long>(map.paged_out),
+        static_cast<unsigned long long>(map.paged_in));
   }
   std::printf("wall_seconds %.2f\npeak_memory_mib %.1f\n", wall_seconds,
               common::process_peak_rss_mib());
@@ -93,6 +98,8 @@ int run(const CLI::App& command, const SemanticOptions& o) {
     config.first = o.first;
     if (command.count("--last") > 0) config.last = o.last;
     config.query_lag = o.query_lag;
+    config.memory_radius_m = o.memory_radius;
+    config.page_dir = o.page_dir;
     std::unique_ptr<tbb::global_control> limit;
     if (o.threads > 0) {
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -138,6 +145,11 @@ void add_kitti_semantic_command(CLI::App& app) {
   command->add_option("--seed", o.seed, "seed of the flips (scan i uses seed + i)");
   command->add_option("--threads", o.threads, "worker threads (default: all cores)");
   command->add_option("--first", o.first, "first scan (index in poses.txt)");
+  command->add_option("--memory-radius", o.memory_radius,
+                      "page blocks beyond this many metres from the car to a block log, as the "
+                      "robot does (map.memory_radius_m); 0: keep the whole map in memory");
+  command->add_option("--page-dir", o.page_dir, "folder for the block logs of --memory-radius")
+      ->default_val("/tmp/semap-dataset-pages");
   command->add_option("--last", o.last, "last scan, included (default: the last pose)");
   command->add_option("--query-lag", o.query_lag,
                       "score scan i in the map after scan i + lag (the reference's 10)");

@@ -71,7 +71,8 @@ std::uint64_t map_checksum(const SemanticMap& map) {
   };
   for (const auto& [index, block] : blocks) {
     mix(&index, sizeof(index));
-    mix(block->evidence().data(), block->evidence().size_bytes());
+    const std::vector<float> evidence = block->dense();
+    mix(evidence.data(), evidence.size() * sizeof(float));
     for (int c = 0; c < block->num_cells(); ++c) {
       const unsigned char bit = block->observed(c) ? 1 : 0;
       mix(&bit, 1);
@@ -330,6 +331,25 @@ void kitti_drive_figures(int scans) {
       "training points/scan %.0f  blocks updated/scan %.0f  blocks %zu  observed cells %zu\n",
       static_cast<double>(training) / scans, static_cast<double>(updated) / scans, stats.blocks,
       stats.observed_cells);
+  // Memory (issue 34 item 2): the map's bytes per observed cell, and how many classes an
+  // observed cell holds evidence for.
+  std::vector<std::size_t> classes_held(static_cast<std::size_t>(p.num_classes) + 1, 0);
+  std::vector<float> cell(static_cast<std::size_t>(p.num_classes));
+  map.for_each_block([&](const semap::common::BlockIndex&, const semap::mapping::Block& b) {
+    for (int c = 0; c < b.num_cells(); ++c) {
+      if (!b.observed(c)) continue;
+      b.read_cell(c, cell);
+      ++classes_held[static_cast<std::size_t>(
+          std::count_if(cell.begin(), cell.end(), [](float v) { return v != 0.0f; }))];
+    }
+  });
+  std::printf("memory: map %.1f MiB, %.1f bytes per observed cell; classes held per observed cell:",
+              static_cast<double>(stats.bytes) / (1 << 20),
+              static_cast<double>(stats.bytes) / static_cast<double>(stats.observed_cells));
+  for (std::size_t k = 0; k < classes_held.size(); ++k) {
+    if (classes_held[k] > 0) std::printf(" %zu: %zu", k, classes_held[k]);
+  }
+  std::printf("; peak RSS %.0f MiB\n", semap::common::process_peak_rss_mib());
   if (sorted.empty()) return;
   std::printf(
       "insert after the first: median %.1f ms  p95 %.1f ms  max %.1f ms;  first scan %.1f ms\n",

@@ -6,10 +6,14 @@
 #include <algorithm>
 #include <chrono>
 #include <deque>
+#include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <utility>
 
 #include "semap/map_io/label_noise.hpp"
+#include "semap/mapping/block_log.hpp"
+#include "semap/mapping/map_checkpoint.hpp"
 
 namespace semap::map_io {
 
@@ -85,6 +89,12 @@ void check(const KittiSemanticConfig& config) {
   if (!(config.flip_fraction >= 0.0 && config.flip_fraction <= 1.0)) {
     throw std::invalid_argument("flip fraction must be in [0, 1]");
   }
+  if (!(config.memory_radius_m >= 0.0)) {
+    throw std::invalid_argument("memory radius must be >= 0 m");
+  }
+  if (config.memory_radius_m > 0.0 && config.page_dir.empty()) {
+    throw std::invalid_argument("a memory radius needs a folder for the block logs");
+  }
 }
 
 }  // namespace
@@ -125,6 +135,19 @@ KittiSemanticResult evaluate_kitti_semantic(
     maps.emplace_back(p);
     result.maps.push_back(KittiMapResult{method, mapping::ConfusionMatrix(kKittiClasses), {}, {}});
   }
+  // Built once the maps stop moving in their vector: pagers hold references to them.
+  std::vector<std::unique_ptr<mapping::BlockLog>> logs;
+  std::vector<std::unique_ptr<mapping::MapPager>> pagers;
+  if (config.memory_radius_m > 0.0) {
+    std::filesystem::create_directories(config.page_dir);
+    for (mapping::SemanticMap& map : maps) {
+      const auto path = config.page_dir / (mapping::to_string(map.params().method) + ".log");
+      std::filesystem::remove(path);
+      logs.push_back(std::make_unique<mapping::BlockLog>(path, map.params(), false));
+      pagers.push_back(
+          std::make_unique<mapping::MapPager>(map, *logs.back(), config.memory_radius_m));
+    }
+  }
   std::deque<PendingScan> pending;
   const auto score_oldest = [&] {
     for (std::size_t m = 0; m < maps.size(); ++m) {
@@ -162,10 +185,12 @@ KittiSemanticResult evaluate_kitti_semantic(
       mappable.labels.push_back(input[i]);
     }
     for (std::size_t m = 0; m < maps.size(); ++m) {
+      if (!pagers.empty()) pagers[m]->update(mappable.origin);
       const auto start = std::chrono::steady_clock::now();
-      maps[m].insert(mappable, mappable.origin);
+      const mapping::InsertResult inserted = maps[m].insert(mappable, mappable.origin);
       result.maps[m].insert_seconds.push_back(
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      if (!pagers.empty()) pagers[m]->after_insert(inserted);
     }
     ++result.scans;
     result.points += cloud.size();
@@ -174,7 +199,13 @@ KittiSemanticResult evaluate_kitti_semantic(
     if (progress) progress(index - config.first + 1, total);
   }
   while (!pending.empty()) score_oldest();
-  for (std::size_t m = 0; m < maps.size(); ++m) result.maps[m].stats = maps[m].stats();
+  for (std::size_t m = 0; m < maps.size(); ++m) {
+    result.maps[m].stats = maps[m].stats();
+    if (!pagers.empty()) {
+      result.maps[m].paged_out = pagers[m]->stats().evicted;
+      result.maps[m].paged_in = pagers[m]->stats().restored;
+    }
+  }
   return result;
 }
 

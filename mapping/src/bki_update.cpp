@@ -23,9 +23,7 @@ class BlockWriter {
     Block& block = block_at_(index);
     if (seen_.insert(index).second) result_.updated_blocks.push_back(index);
     const int c = grid_.local_index(cell, index);
-    float* alpha = block.cell_evidence_mutable(c);
-    for (std::size_t k = 0; k < y.size(); ++k) alpha[k] += w * y[k];
-    block.mark_observed(c);
+    for (std::size_t k = 0; k < y.size(); ++k) block.add(c, static_cast<int>(k), w * y[k]);
   }
 
  private:

@@ -134,7 +134,8 @@ class ColumnReader {
       : map_(map),
         p_(p),
         band_low_(static_cast<int>(std::ceil(p.min_height_m / map.resolution - 1e-6))),
-        band_high_(static_cast<int>(std::floor(p.max_height_m / map.resolution + 1e-6))) {}
+        band_high_(static_cast<int>(std::floor(p.max_height_m / map.resolution + 1e-6))),
+        values_(static_cast<std::size_t>(map.channels())) {}
 
   void read(std::span<const std::pair<common::BlockIndex, const Block*>> stack, int x, int y,
             CellEvidence& evidence) {
@@ -144,8 +145,9 @@ class ColumnReader {
       for (int z = 0; z < side; ++z) {
         const int c = block->cell_of(x, y, z);
         if (!block->observed(c)) continue;
-        const auto cell = common::CellPosterior(block->cell_evidence(c), map_.prior, true)
-                              .summary(map_.unknown_variance);
+        block->read_cell(c, values_);
+        const auto cell =
+            common::CellPosterior(values_, map_.prior, true).summary(map_.unknown_variance);
         if (cell.state == common::CellState::kUnknown) continue;
         if (cell.state == common::CellState::kFree) {
           evidence.free = true;
@@ -181,6 +183,7 @@ class ColumnReader {
   int band_low_;   // rule 4's band in cells above the ground cell
   int band_high_;  // (centres min_height_m .. max_height_m above it)
   std::vector<OccupiedCell> occupied_;
+  std::vector<float> values_;  // the cell being read
 };
 
 // Recomputes the cells of `costmap` in `rect` for which `dirty` (one flag per costmap cell;

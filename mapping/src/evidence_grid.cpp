@@ -9,9 +9,6 @@ namespace semap::mapping {
 
 namespace {
 
-// Malloc bookkeeping per heap allocation, counted so bytes per cell is not flattering.
-constexpr std::size_t kAllocOverhead = 16;
-
 [[noreturn, gnu::noinline]] void throw_out_of_range(const common::BlockIndex& key) {
   throw std::invalid_argument("block (" + std::to_string(key.x) + ", " + std::to_string(key.y) +
                               ", " + std::to_string(key.z) + ") beyond the map's +-2^20 range");
@@ -40,10 +37,8 @@ EvidenceGrid::EvidenceGrid(const EvidenceGrid& other)
     : EvidenceGrid(other.block_side_, other.channels_) {
   updates_ = other.updates_;
   table_.reset(other.size());
-  reserve(other.size());
-  other.for_each_block([&](const common::BlockIndex& key, const Block& block) {
-    block_at(key).restore(block.evidence(), block.observed_words());
-  });
+  other.for_each_block(
+      [&](const common::BlockIndex& key, const Block& block) { block_at(key) = block; });
 }
 
 EvidenceGrid& EvidenceGrid::operator=(const EvidenceGrid& other) {
@@ -56,10 +51,10 @@ Block& EvidenceGrid::block_at(const common::BlockIndex& key) {
   const std::uint32_t id = table_.insert(key);
   if (id == blocks_.size()) {
     keys_.push_back(key);
-    blocks_.emplace_back(block_side_, channels_, new_storage());
+    blocks_.emplace_back(block_side_, channels_);
     resident_.push_back(1);
   } else if (!resident_[id]) {
-    blocks_[id] = Block(block_side_, channels_, new_storage());
+    blocks_[id] = Block(block_side_, channels_);
     resident_[id] = 1;
     --evicted_;
   }
@@ -76,19 +71,20 @@ Block* EvidenceGrid::find_block(const common::BlockIndex& key) {
   return const_cast<Block*>(std::as_const(*this).find_block(key));
 }
 
-std::span<float> EvidenceGrid::cell(const common::CellIndex& cell) {
-  const common::BlockIndex key = common::block_of_cell(cell, block_side_);
-  Block& block = block_at(key);
-  const int local = common::local_index(cell, key, block_side_);
-  block.mark_observed(local);
-  return {block.cell_evidence_mutable(local), static_cast<std::size_t>(channels_)};
-}
-
-std::span<const float> EvidenceGrid::find(const common::CellIndex& cell) const {
+bool EvidenceGrid::read_cell(const common::CellIndex& cell, std::span<float> out) const {
   const common::BlockIndex key = common::block_of_cell(cell, block_side_);
   const Block* block = find_block(key);
-  if (block == nullptr) return {};
-  return block->cell_evidence(common::local_index(cell, key, block_side_));
+  if (block == nullptr) {
+    std::fill(out.begin(), out.end(), 0.0f);
+    return false;
+  }
+  block->read_cell(common::local_index(cell, key, block_side_), out);
+  return true;
+}
+
+void EvidenceGrid::set_cell(const common::CellIndex& cell, std::span<const float> values) {
+  const common::BlockIndex key = common::block_of_cell(cell, block_side_);
+  block_at(key).set_cell(common::local_index(cell, key, block_side_), values);
 }
 
 void EvidenceGrid::check_block(const common::BlockIndex& key,
@@ -120,23 +116,10 @@ bool EvidenceGrid::evict(const common::BlockIndex& key) {
   if (!in_range(key)) return false;
   const std::uint32_t id = table_.find(key);
   if (id == VoxelHashMap::kNone || !resident_[id]) return false;
-  spare_storage_.push_back(blocks_[id].cell_evidence_mutable(0));
-  blocks_[id] = Block(block_side_, channels_, nullptr);
+  blocks_[id] = Block(block_side_, channels_);
   resident_[id] = 0;
   ++evicted_;
   return true;
-}
-
-void EvidenceGrid::reserve(std::size_t blocks) {
-  arena_.reserve(blocks * (block_floats() * sizeof(float) + 64));
-}
-
-float* EvidenceGrid::new_storage() {
-  if (spare_storage_.empty()) return arena_.allocate(block_floats());
-  float* storage = spare_storage_.back();
-  spare_storage_.pop_back();
-  std::fill_n(storage, block_floats(), 0.0f);
-  return storage;
 }
 
 std::vector<common::BlockIndex> EvidenceGrid::keys() const {
@@ -147,12 +130,11 @@ std::vector<common::BlockIndex> EvidenceGrid::keys() const {
 }
 
 std::size_t EvidenceGrid::bytes() const {
-  // Table, key list and the deque's slots; per block its observed bits (one heap allocation);
-  // the arena holds the evidence, its alignment padding and the storage kept for reuse.
+  // Table, key list and the deque's slots (evicted blocks' too), then each block's heap.
   std::size_t bytes = table_.bytes() + keys_.capacity() * sizeof(common::BlockIndex) +
-                      blocks_.size() * sizeof(Block) + arena_.bytes_used();
+                      resident_.capacity() + blocks_.size() * sizeof(Block);
   for_each_block([&](const common::BlockIndex&, const Block& block) {
-    bytes += block.bytes() - sizeof(Block) - block.evidence().size_bytes() + kAllocOverhead;
+    bytes += block.bytes() - sizeof(Block);
   });
   return bytes;
 }
@@ -165,7 +147,7 @@ bool EvidenceGrid::operator==(const EvidenceGrid& other) const {
   bool equal = true;
   for_each_block([&](const common::BlockIndex& key, const Block& block) {
     const Block* theirs = other.find_block(key);
-    equal = equal && theirs != nullptr && std::ranges::equal(block.evidence(), theirs->evidence());
+    equal = equal && theirs != nullptr && block.dense() == theirs->dense();
   });
   return equal;
 }

@@ -103,14 +103,14 @@ void remerge_blocks(LayeredMap& fused, SourceId source, const EvidenceGrid& laye
   for (const auto& target : targets) {
     for (const auto& key : source_blocks(target, from, to, T_to_from)) {
       if (!taken.insert(key).second) continue;
-      if (const Block* block = layer.find_block(key)) needed.put_block(key, block->evidence());
+      if (const Block* block = layer.find_block(key)) needed.put_block(key, block->dense());
     }
   }
   EvidenceGrid rebuilt = resample_layer(needed, from, to, T_to_from);
   EvidenceGrid& out = fused.layer(source);
   for (const auto& target : targets) {
     if (const Block* block = rebuilt.find_block(target)) {
-      out.put_block(target, block->evidence());
+      out.put_block(target, block->dense());
     } else {
       out.evict(target);
     }

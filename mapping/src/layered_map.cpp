@@ -44,9 +44,9 @@ void LayeredMap::finish_fusion(std::span<float> out) const {
 bool LayeredMap::fused(const common::CellIndex& cell, std::span<float> out) const {
   std::fill(out.begin(), out.end(), 0.0f);
   bool known = false;
+  std::vector<float> values(out.size());
   for (const auto& [source, grid] : layers_) {
-    const auto values = grid.find(cell);
-    if (values.empty()) continue;
+    if (!grid.read_cell(cell, values)) continue;
     fuse_into(values, out);
     known = known || std::any_of(values.begin(), values.end(), [](float v) { return v != 0.0f; });
   }
@@ -61,7 +61,7 @@ bool LayeredMap::fused_block(const common::BlockIndex& key, std::vector<float>& 
   for (const auto& [source, grid] : layers_) {
     const Block* block = grid.find_block(key);
     if (block == nullptr) continue;
-    fuse_into(block->evidence(), out);
+    fuse_into(block->dense(), out);
     any = true;
   }
   const auto channels = static_cast<std::size_t>(params_.channels());

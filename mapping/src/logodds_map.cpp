@@ -57,6 +57,7 @@ LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
   CellSet hits;
   CellSet free;
   LogOddsInsertResult result;
+  std::vector<float> values(static_cast<std::size_t>(grid.channels()));  // one cell's channels
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d point = cloud.points[i].cast<double>();
     if (!storable(point) || !storable(origin) ||
@@ -75,21 +76,25 @@ LogOddsInsertResult LogOddsMap::insert(const common::LabeledCloud& cloud) {
     }
     const common::CellIndex cell = p.grid().cell_of(point);
     hits.insert(cell);
-    const std::span<float> labels = grid.cell(cell).subspan(1);
+    grid.read_cell(cell, values);
+    const std::span<float> labels = std::span(values).subspan(1);
     if (cloud.has_probabilities()) {
       model_.add_label_probabilities(labels, std::span(cloud.probabilities).subspan(i * k, k));
     } else {
       model_.add_hard_label(labels, cloud.labels[i]);
     }
+    grid.set_cell(cell, values);
   }
-  for (const common::CellIndex& cell : hits) {
-    float& occ = grid.cell(cell)[0];
-    occ = model_.clamp(occ + model_.hit());
-  }
+  // Adds `change` to a cell's occupancy log-odds, clamped.
+  const auto update_occupancy = [&](const common::CellIndex& cell, float change) {
+    grid.read_cell(cell, values);
+    values[0] = model_.clamp(values[0] + change);
+    grid.set_cell(cell, values);
+  };
+  for (const common::CellIndex& cell : hits) update_occupancy(cell, model_.hit());
   for (const common::CellIndex& cell : free) {
     if (hits.contains(cell)) continue;
-    float& occ = grid.cell(cell)[0];
-    occ = model_.clamp(occ + model_.miss());
+    update_occupancy(cell, model_.miss());
     ++result.free_cells;
   }
   result.hit_cells = hits.size();

@@ -55,10 +55,8 @@ MapCheckpoint::Batch MapCheckpoint::copy_dirty() {
     // A block a pager moved out is already in the log, newer than any copy here.
     const Block* block = map_.find_block(index);
     if (block == nullptr) continue;
-    const auto evidence = block->evidence();
     const auto observed = block->observed_words();
-    batch.blocks.push_back(
-        {index, {evidence.begin(), evidence.end()}, {observed.begin(), observed.end()}});
+    batch.blocks.push_back({index, block->dense(), {observed.begin(), observed.end()}});
   }
   dirty_.clear();
   return batch;
@@ -182,7 +180,7 @@ std::vector<common::BlockIndex> MapPager::update(const Eigen::Vector3f& robot) {
   for (const common::BlockIndex& index : far) {
     const Block& block = *map_.find_block(index);
     try {
-      log_.append(index, scans, block.evidence(), block.observed_words());
+      log_.append(index, scans, block.dense(), block.observed_words());
     } catch (const BlockLogError& e) {
       // Only a block the log holds may leave memory. The rest wait for the next update: one
       // failed record per insert while the disk is full, not one per far block.

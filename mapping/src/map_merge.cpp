@@ -36,6 +36,7 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const MapParams& from_par
   Block* target_block = nullptr;
   common::BlockIndex target_key;
   layer.for_each_block([&](const common::BlockIndex& key, const Block& block) {
+    const std::vector<float> evidence = block.dense();
     // Bounding box of the source block in the target frame; every target cell whose centre
     // maps back into this block lies inside it.
     const Eigen::Vector3d lo =
@@ -60,7 +61,7 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const MapParams& from_par
           if (from_grid.block_of(source) != key) continue;
           const auto offset =
               static_cast<std::size_t>(from_grid.local_index(source, key)) * channels;
-          const std::span<const float> values(block.evidence().data() + offset, channels);
+          const std::span<const float> values(evidence.data() + offset, channels);
           if (!any_nonzero(values)) continue;
           const common::BlockIndex key_of_target = to_grid.block_of(target);
           if (target_block == nullptr || key_of_target != target_key) {
@@ -68,8 +69,7 @@ EvidenceGrid resample_layer(const EvidenceGrid& layer, const MapParams& from_par
             target_key = key_of_target;
           }
           const int local = to_grid.local_index(target, target_key);
-          std::copy(values.begin(), values.end(), target_block->cell_evidence_mutable(local));
-          target_block->mark_observed(local);
+          target_block->set_cell(local, values);
         }
       }
     }

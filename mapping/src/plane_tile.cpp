@@ -183,8 +183,8 @@ void PlaneTile::add(const CellBox& box, const std::array<const float*, 3>& d2, s
 #endif
 }
 
-void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& block) {
-  const std::int32_t n = block.cells_per_side();
+void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, BlockDelta& delta) {
+  const std::int32_t n = delta.cells_per_side();
   const std::size_t k = k_;
   const std::size_t plane = plane_;
   const std::uint64_t low = (std::uint64_t{1} << n) - 1;
@@ -197,12 +197,13 @@ void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& blo
       // exact and leaves the scratch zeroed.
       float* src = planes_.data() + row * static_cast<std::size_t>(side_) +
                    static_cast<std::size_t>(first[0]);
-      const int cell = block.cell_of(0, y, z);
-      float* dst = block.cell_evidence_mutable(cell);
-      block.mark_observed_word(cell >> 6, bits << (cell & 63));
+      const int cell = (z * n + y) * n;
+      float* dst = delta.cell(cell);
+      delta.mark_word(cell >> 6, bits << (cell & 63));
       // Few classes (hard labels; K <= 64 so the mask covers them): those planes alone.
       const std::uint64_t classes = row_classes_[row];
       if (k <= 64 && static_cast<std::size_t>(std::popcount(classes)) * 4 <= k) {
+        delta.mark_channels(classes);
         for (std::uint64_t left = classes; left != 0; left &= left - 1) {
           const auto c = static_cast<std::size_t>(std::countr_zero(left));
           float* p = src + c * plane;
@@ -213,6 +214,7 @@ void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& blo
         }
         continue;
       }
+      delta.mark_all_channels();
       std::size_t c = 0;
 #if defined(__SSE2__)
       // Rows of 4 cells (blocks of depth 3): 4 classes at a time, a 4x4 transpose from
@@ -242,22 +244,6 @@ void PlaneTile::flush_block(const std::array<std::int32_t, 3>& first, Block& blo
           p[x] = 0.0f;
         }
       }
-    }
-  }
-}
-
-void PlaneTile::prefetch_block(const std::array<std::int32_t, 3>& first, const Block& block) const {
-  const std::int32_t n = block.cells_per_side();
-  const std::uint64_t low = (std::uint64_t{1} << n) - 1;
-  constexpr std::size_t kLine = 64;
-  const std::size_t row_bytes = static_cast<std::size_t>(n) * k_ * sizeof(float);
-  for (std::int32_t z = 0; z < n; ++z) {
-    for (std::int32_t y = 0; y < n; ++y) {
-      const auto row = static_cast<std::size_t>((first[2] + z) * side_ + first[1] + y);
-      if (((std::uint64_t{rows_[row]} >> first[0]) & low) == 0) continue;
-      const char* bytes =
-          reinterpret_cast<const char*>(block.cell_evidence(block.cell_of(0, y, z)).data());
-      for (std::size_t b = 0; b < row_bytes; b += kLine) __builtin_prefetch(bytes + b, 1);
     }
   }
 }

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "semap/mapping/block.hpp"
+#include "semap/mapping/block_delta.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "support_box.hpp"
 
@@ -23,7 +23,7 @@ namespace semap::mapping::detail {
 // padding) adding +0.0 there, which leaves those cells unchanged. One bit mask per row of
 // cells records the cells that got weight: they are the only non-zero ones; a second one per
 // row records the classes that did (hard labels: a few of K), so that flush_block moves only
-// those planes (adding the others' +0.0 would leave the block unchanged).
+// those planes (adding the others' +0.0 would leave the delta unchanged).
 class PlaneTile {
  public:
   PlaneTile(std::int32_t side, int num_classes);
@@ -35,14 +35,9 @@ class PlaneTile {
   void add(const CellBox& box, const std::array<const float*, 3>& d2, std::int32_t label,
            const float* y, const KernelPolynomial& kernel);
 
-  // Adds the n^3 cells starting at tile-local cell `first` to `block` (n cells per side),
-  // marks the cells that got weight as observed, and zeroes them here.
-  void flush_block(const std::array<std::int32_t, 3>& first, Block& block);
-
-  // Asks the cache for the rows of `block` that flush_block(first, block) will update: the
-  // map's blocks are scattered in memory, and flushing one while the next is fetched hides
-  // most of the misses that otherwise dominate the flush.
-  void prefetch_block(const std::array<std::int32_t, 3>& first, const Block& block) const;
+  // Adds the n^3 cells starting at tile-local cell `first` to the zeroed `delta` (a block of n
+  // cells per side), marks the cells that got weight there, and zeroes them here.
+  void flush_block(const std::array<std::int32_t, 3>& first, BlockDelta& delta);
 
   // Clears the row masks once every block of the tile has been flushed.
   void clear_marks();

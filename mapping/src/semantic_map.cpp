@@ -23,10 +23,7 @@ SemanticMap::SemanticMap(const MapParams& params, SourceId robot)
       layers_(params),
       robot_(robot),
       grid_(&layers_.layer(robot)),
-      inserter_(std::make_unique<detail::TileInserter>(params)) {
-  // A live map soon holds many MB: 32 MiB of storage at once, in huge pages.
-  grid_->reserve((std::size_t{32} << 20) / (grid_->block_floats() * sizeof(float)));
-}
+      inserter_(std::make_unique<detail::TileInserter>(params)) {}
 
 SemanticMap::~SemanticMap() = default;
 SemanticMap::SemanticMap(SemanticMap&&) noexcept = default;
@@ -185,7 +182,7 @@ Eigen::Vector3f SemanticMap::cell_center(const common::BlockIndex& block, int ce
   return grid.cell_centre(grid.cell_of_local(block, cell));
 }
 
-std::optional<common::CellPosterior> SemanticMap::query(const Eigen::Vector3f& point) const {
+std::optional<CellReading> SemanticMap::query(const Eigen::Vector3f& point) const {
   if (!detail::mappable(point, 1.0f / params_.resolution)) return std::nullopt;
   const common::MapGrid grid = params_.grid();
   const common::CellIndex cell = grid.cell_of(point);
@@ -193,7 +190,9 @@ std::optional<common::CellPosterior> SemanticMap::query(const Eigen::Vector3f& p
   const Block* block = find_block(index);
   if (block == nullptr) return std::nullopt;
   const int c = grid.local_index(cell, index);
-  return common::CellPosterior(block->cell_evidence(c), params_.prior, block->observed(c));
+  std::vector<float> evidence(static_cast<std::size_t>(block->channels()));
+  block->read_cell(c, evidence);
+  return CellReading(std::move(evidence), params_.prior, block->observed(c));
 }
 
 int SemanticMap::label_at(const Eigen::Vector3f& point) const {

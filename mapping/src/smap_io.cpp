@@ -250,7 +250,7 @@ std::vector<std::uint8_t> encode_smap(const LayeredMap& map) {
     w.put(static_cast<std::uint32_t>(grid.size()));
     w.put_crc_since(start);
     for (const common::BlockIndex& key : sorted_keys(grid)) {
-      const auto block = grid.find_block(key)->evidence();
+      const std::vector<float> block = grid.find_block(key)->dense();
       const std::size_t block_start = w.size();
       w.put(kBlockTag);
       w.put(key.x);

@@ -79,7 +79,7 @@ inline void gathered_weights(const float* d2, std::size_t count, const KernelPol
 // of local cell box.lo[a] + c (readable 8 floats past the box). Hard labels touch one float
 // per cell.
 template <bool kSoft>
-void smooth_point(Block& block, std::int32_t side, const CellBox& box,
+void smooth_point(BlockDelta& delta, std::int32_t side, const CellBox& box,
                   const std::array<const float*, 3>& d2, const TrainingSet& training, std::size_t i,
                   const KernelPolynomial& kernel) {
   const auto k = static_cast<std::size_t>(training.num_classes);
@@ -88,7 +88,12 @@ void smooth_point(Block& block, std::int32_t side, const CellBox& box,
   const std::size_t label = kSoft ? 0 : static_cast<std::size_t>(training.labels[i]);
   const std::int32_t width = box.hi[0] - box.lo[0] + 1;
   const float* dx2 = d2[0];
-  float* const evidence = block.cell_evidence_mutable(0);
+  float* const evidence = delta.cell(0);
+  if constexpr (kSoft) {
+    delta.mark_all_channels();
+  } else {
+    delta.mark_channel(static_cast<int>(label));
+  }
   // Squared distances and evidence offsets of the gathered cells, then their weights.
   alignas(32) std::array<float, kGatherCells + 8> cell_d2;
   std::array<std::uint32_t, kGatherCells> cell_offset;
@@ -132,8 +137,7 @@ void smooth_point(Block& block, std::int32_t side, const CellBox& box,
             static_cast<std::uint32_t>((row_first + static_cast<std::size_t>(x)) * k);
         ++count;
       }
-      block.mark_observed_word(static_cast<int>(row >> 6),
-                               std::uint64_t{mask << box.lo[0]} << (row & 63));
+      delta.mark_word(static_cast<int>(row >> 6), std::uint64_t{mask << box.lo[0]} << (row & 63));
     }
   }
   add_gathered();
@@ -151,12 +155,13 @@ TileInserter::TileInserter(const MapParams& params)
                        blocks_per_tile_side_ +
                    63) /
                   64),
-      // Only blocks written in place read their axis distances from the plan; scratch tiles
+      // Only one-block tiles read their axis distances from the plan; scratch tiles
       // compute each piece's (see process_tile).
       width_(params.method == MapMethod::kCsm || tile_shift_ != block_shift_
                  ? 0
                  : distances_per_axis(params)),
-      scratch_(std::int32_t{1} << tile_shift_, params.num_classes) {}
+      scratch_(std::int32_t{1} << tile_shift_, params.num_classes),
+      deltas_(std::int32_t{1} << block_shift_, params.num_classes) {}
 
 void TileInserter::create_blocks(TilePlan& plan, const BlockAt& block_at, const BlockFind& find,
                                  TileInsertResult& result) const {
@@ -210,7 +215,7 @@ inline Piece TileInserter::piece_of(const TilePlan& plan, std::size_t i,
   return piece;
 }
 
-void TileInserter::scatter_in_place(const TilePlan& plan, Block& block,
+void TileInserter::scatter_in_place(const TilePlan& plan, BlockDelta& delta,
                                     const std::array<std::int32_t, 3>& base, std::size_t i,
                                     const TrainingSet& training) const {
   const std::int32_t side = 1 << tile_shift_;
@@ -218,47 +223,42 @@ void TileInserter::scatter_in_place(const TilePlan& plan, Block& block,
   if (params_.method == MapMethod::kCsm) {
     // The support is the point's cell, inside this block.
     const CellBox& cell_box = plan.boxes[i];
+    const std::int32_t n = delta.cells_per_side();
     const int cell =
-        block.cell_of(cell_box.lo[0] - base[0], cell_box.lo[1] - base[1], cell_box.lo[2] - base[2]);
-    float* alpha = block.cell_evidence_mutable(cell);
+        ((cell_box.lo[2] - base[2]) * n + cell_box.lo[1] - base[1]) * n + cell_box.lo[0] - base[0];
+    float* alpha = delta.cell(cell);
     if (training.labels[i] >= 0) {
       alpha[training.labels[i]] += 1.0f;
+      delta.mark_channel(training.labels[i]);
     } else {
       const float* y = training.probabilities.data() + i * k;
       for (std::size_t c = 0; c < k; ++c) alpha[c] += y[c];
+      delta.mark_all_channels();
     }
-    block.mark_observed(cell);
+    delta.mark(cell);
     return;
   }
   const Piece piece = piece_of(plan, i, base);
   const CellBox& box = piece.box;
   if (training.labels[i] >= 0) {
-    smooth_point<false>(block, side, box, piece.d2, training, i, polynomial_);
+    smooth_point<false>(delta, side, box, piece.d2, training, i, polynomial_);
   } else {
-    smooth_point<true>(block, side, box, piece.d2, training, i, polynomial_);
+    smooth_point<true>(delta, side, box, piece.d2, training, i, polynomial_);
   }
 }
 
-void TileInserter::write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile) const {
+void TileInserter::write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile) {
   const std::int32_t n = 1 << block_shift_;
   const std::int32_t t_side = blocks_per_tile_side_;
-  const auto first_cell = [&](std::uint32_t j) -> std::array<std::int32_t, 3> {
-    const auto local = static_cast<std::int32_t>(plan.tile_blocks[j].local);
-    return {(local % t_side) * n, ((local / t_side) % t_side) * n, (local / (t_side * t_side)) * n};
-  };
-  // Blocks are fetched kPrefetchBlocks ahead of their flush.
-  constexpr std::uint32_t kPrefetchBlocks = 2;
-  const std::uint32_t begin = plan.block_offsets[tile];
+  BlockDelta& delta = deltas_.local();
   const std::uint32_t end = plan.block_offsets[tile + 1];
-  for (std::uint32_t j = begin; j < std::min(end, begin + kPrefetchBlocks); ++j) {
-    scratch.prefetch_block(first_cell(j), *plan.tile_blocks[j].block);
-  }
-  for (std::uint32_t j = begin; j < end; ++j) {
-    if (j + kPrefetchBlocks < end) {
-      scratch.prefetch_block(first_cell(j + kPrefetchBlocks),
-                             *plan.tile_blocks[j + kPrefetchBlocks].block);
-    }
-    scratch.flush_block(first_cell(j), *plan.tile_blocks[j].block);
+  for (std::uint32_t j = plan.block_offsets[tile]; j < end; ++j) {
+    if (j + 1 < end) plan.tile_blocks[j + 1].block->prefetch();
+    const auto local = static_cast<std::int32_t>(plan.tile_blocks[j].local);
+    scratch.flush_block(
+        {(local % t_side) * n, ((local / t_side) % t_side) * n, (local / (t_side * t_side)) * n},
+        delta);
+    plan.tile_blocks[j].block->add(delta);
   }
   scratch.clear_marks();
 }
@@ -269,11 +269,12 @@ void TileInserter::process_tile(const TilePlan& plan, std::size_t tile,
                                          plan.tiles[tile].y << tile_shift_,
                                          plan.tiles[tile].z << tile_shift_};
   if (tile_shift_ == block_shift_) {
-    // The tile is one block: write into it directly, in the same order as the scratch would.
-    Block& block = *plan.tile_blocks[plan.block_offsets[tile]].block;
+    // The tile is one block: its points sum their weights in the block's delta.
+    BlockDelta& delta = deltas_.local();
     for (std::uint32_t p = plan.tile_offsets[tile]; p < plan.tile_offsets[tile + 1]; ++p) {
-      scatter_in_place(plan, block, base, plan.tile_points[p], training);
+      scatter_in_place(plan, delta, base, plan.tile_points[p], training);
     }
+    plan.tile_blocks[plan.block_offsets[tile]].block->add(delta);
     return;
   }
   const auto k = static_cast<std::size_t>(params_.num_classes);
@@ -319,8 +320,8 @@ TileInsertResult TileInserter::apply(TilePlan& plan, const TrainingSet& training
   // Creating blocks mutates the map's table, so it happens before the parallel part.
   create_blocks(plan, block_at, find, result);
   result.phases.blocks = clock.lap();
-  // Blocks written in place are small (S-CSM: a few points each) and go in groups of
-  // kBlocksPerTask to keep the task overhead down.
+  // One-block tiles are small (S-CSM: a few points each) and go in groups of kBlocksPerTask
+  // to keep the task overhead down.
   const bool in_place = tile_shift_ == block_shift_;
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, plan.tiles.size(), in_place ? kBlocksPerTask : 1),

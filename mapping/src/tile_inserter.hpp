@@ -17,6 +17,7 @@
 #include "semap/common/map_grid.hpp"
 #include "semap/mapping/bki_update.hpp"
 #include "semap/mapping/block.hpp"
+#include "semap/mapping/block_delta.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/map_params.hpp"
 #include "semap/mapping/semantic_map.hpp"
@@ -54,7 +55,7 @@ struct TileBlock {
 // blocks once they exist (TileInserter::apply). Kept across scans to reuse the buffers.
 struct TilePlan {
   std::vector<CellBox> boxes;     // support of each training point (empty if unusable)
-  std::vector<float> distances;   // blocks in place: squared axis distances, 3 * width_ per point
+  std::vector<float> distances;   // one-block tiles: squared axis distances, 3 * width_ per point
   std::vector<std::uint8_t> bad;  // 1 for rejected points
   std::size_t rejected_points = 0;
   std::vector<std::uint32_t> pair_first;  // count + 1: first (point, tile) pair of each point
@@ -82,9 +83,10 @@ struct TilePlan {
 // tile (a PlaneTile, one plane per class) instead of finding the block of every row.
 //
 // Every tile is processed by one task that visits its points in input order. With a scratch
-// tile it adds their weights into the zeroed scratch, then adds the scratch to the tile's
-// blocks and zeroes it again: per cell, evidence + (this scan's weights summed in input
-// order). A one-block tile is written in place. Neither depends on the thread count.
+// tile it adds their weights into the zeroed scratch, then moves each block's part into a
+// BlockDelta and merges that into the block; a one-block tile adds them into the delta
+// directly. Either way, per cell: evidence + (this scan's weights summed in input order),
+// independent of the thread count.
 class TileInserter {
  public:
   explicit TileInserter(const MapParams& params);
@@ -116,9 +118,10 @@ class TileInserter {
   void process_tile(const TilePlan& plan, std::size_t tile, const TrainingSet& training);
   Piece piece_of(const TilePlan& plan, std::size_t i,
                  const std::array<std::int32_t, 3>& base) const;
-  void scatter_in_place(const TilePlan& plan, Block& block, const std::array<std::int32_t, 3>& base,
-                        std::size_t i, const TrainingSet& training) const;
-  void write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile) const;
+  void scatter_in_place(const TilePlan& plan, BlockDelta& delta,
+                        const std::array<std::int32_t, 3>& base, std::size_t i,
+                        const TrainingSet& training) const;
+  void write_back(const TilePlan& plan, PlaneTile& scratch, std::size_t tile);
 
   MapParams params_;
   KernelPolynomial polynomial_;  // the one kernel approximation, of every block size
@@ -132,6 +135,7 @@ class TileInserter {
 
   TilePlan plan_;                                       // of insert()
   tbb::enumerable_thread_specific<PlaneTile> scratch_;  // created on first use per thread
+  tbb::enumerable_thread_specific<BlockDelta> deltas_;  // one block's sums, per thread
 };
 
 }  // namespace semap::mapping::detail

@@ -30,7 +30,7 @@ void to_snapshot(const mapping::SemanticMap& map, const common::BlockIndex& inde
   for (int c = 0; c < block.num_cells(); ++c) {
     observed[static_cast<std::size_t>(c)] = block.observed(c) ? 1 : 0;
   }
-  dds_idl::snapshot_of_evidence(index, params.grid(), block.channels(), block.evidence(), observed,
+  dds_idl::snapshot_of_evidence(index, params.grid(), block.channels(), block.dense(), observed,
                                 params.prior, params.unknown_variance, version, with_evidence, out);
 }
 

@@ -186,6 +186,44 @@ TEST(KittiSemanticEval, MapsFromNoisyGroundTruthBeatTheirInput) {
   }
 }
 
+// A patch of road seen at x = 0, then 100 m away, then at x = 0 again: with a 20 m memory
+// radius the first patch goes to the log while the car is away and comes back when it returns,
+// so the maps score as the unpaged ones and hold fewer blocks at the end.
+TEST(KittiSemanticEval, PagedMapsScoreAsTheWholeMapsAndHoldLess) {
+  KittiTestSequence files;
+  const std::vector<Eigen::Vector3d> positions{{0, 0, 0}, {100, 0, 0}, {0, 0, 0}};
+  files.write_poses(positions);
+  std::vector<Eigen::Vector3f> sensor;
+  std::vector<std::uint32_t> labels;
+  for (int i = 0; i < 40; ++i) {
+    for (int j = 0; j < 40; ++j) {
+      sensor.emplace_back(2.0f + 0.05f * static_cast<float>(i),
+                          -1.0f + 0.05f * static_cast<float>(j), -1.5f);
+      labels.push_back(j < 30 ? kRawRoad : kRawSidewalk);
+    }
+  }
+  for (std::size_t s = 0; s < positions.size(); ++s) files.write_scan(s, sensor, labels);
+  KittiSemanticConfig config;
+  config.flip_fraction = 0.2;
+  config.query_lag = 0;  // each scan scored where it was taken
+  const KittiSemanticResult whole = evaluate_kitti_semantic(files.dir(), config);
+  config.memory_radius_m = 20.0;
+  config.page_dir = files.dir() / "pages";
+  const KittiSemanticResult paged = evaluate_kitti_semantic(files.dir(), config);
+  ASSERT_EQ(paged.maps.size(), whole.maps.size());
+  for (std::size_t m = 0; m < paged.maps.size(); ++m) {
+    const std::string method = mapping::to_string(paged.maps[m].method);
+    EXPECT_GT(paged.maps[m].paged_out, 0u) << method;
+    EXPECT_GT(paged.maps[m].paged_in, 0u) << method;
+    EXPECT_LT(paged.maps[m].stats.blocks, whole.maps[m].stats.blocks) << method;
+    EXPECT_EQ(kitti_mean_iou(paged.maps[m].confusion), kitti_mean_iou(whole.maps[m].confusion))
+        << method;
+    EXPECT_TRUE(std::filesystem::exists(config.page_dir / (method + ".log"))) << method;
+  }
+  config.page_dir.clear();
+  EXPECT_THROW(evaluate_kitti_semantic(files.dir(), config), std::invalid_argument);
+}
+
 TEST(KittiIouTable, RefusesRowsOfOtherClassCounts) {
   const mapping::ConfusionMatrix four(4);
   const std::vector<IouTableRow> rows{{"x", &four}};

@@ -38,9 +38,9 @@ void expect_identical(const SemanticMap& a, const SemanticMap& b) {
   a.for_each_block([&](const common::BlockIndex& index, const Block& block) {
     const Block* other = b.find_block(index);
     ASSERT_NE(other, nullptr);
-    ASSERT_EQ(std::memcmp(block.evidence().data(), other->evidence().data(),
-                          block.evidence().size_bytes()),
-              0);
+    const std::vector<float> x = block.dense();
+    const std::vector<float> y = other->dense();
+    ASSERT_EQ(std::memcmp(x.data(), y.data(), x.size() * sizeof(float)), 0);
     for (int c = 0; c < block.num_cells(); ++c) ASSERT_EQ(block.observed(c), other->observed(c));
     ++compared;
   });

@@ -30,8 +30,9 @@ std::map<CellKey, Cell> cells_of(const SemanticMap& map) {
   map.for_each_block([&](const common::BlockIndex& index, const Block& block) {
     for (int c = 0; c < block.num_cells(); ++c) {
       const common::CellIndex cell = grid.cell_of_local(index, c);
-      const auto e = block.cell_evidence(c);
-      out[{cell.x(), cell.y(), cell.z()}] = {{e.begin(), e.end()}, block.observed(c)};
+      std::vector<float> e(static_cast<std::size_t>(block.channels()));
+      block.read_cell(c, e);
+      out[{cell.x(), cell.y(), cell.z()}] = {e, block.observed(c)};
     }
   });
   return out;

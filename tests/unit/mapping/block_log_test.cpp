@@ -44,7 +44,7 @@ class BlockLogTest : public ::testing::Test {
 
   static void append_all(BlockLog& log, const SemanticMap& map) {
     map.for_each_block([&](const common::BlockIndex& index, const Block& block) {
-      log.append(index, map.scans(), block.evidence(), block.observed_words());
+      log.append(index, map.scans(), block.dense(), block.observed_words());
     });
   }
 
@@ -53,8 +53,7 @@ class BlockLogTest : public ::testing::Test {
     a.for_each_block([&](const common::BlockIndex& index, const Block& block) {
       const Block* other = b.find_block(index);
       ASSERT_NE(other, nullptr);
-      ASSERT_TRUE(
-          std::equal(block.evidence().begin(), block.evidence().end(), other->evidence().begin()));
+      ASSERT_EQ(block.dense(), other->dense());
       ASSERT_TRUE(std::equal(block.observed_words().begin(), block.observed_words().end(),
                              other->observed_words().begin()));
       ++blocks;
@@ -176,12 +175,11 @@ TEST_F(BlockLogTest, AnOlderCopyDoesNotReplaceANewerOne) {
   const common::BlockIndex index = params_.grid().block_of(Eigen::Vector3f(0.1f, 0.1f, 0.1f));
   const Block& n = *newer.find_block(index);
   const Block& o = *older.find_block(index);
-  log.append(index, 2, n.evidence(), n.observed_words());
-  log.append(index, 1, o.evidence(), o.observed_words());
+  log.append(index, 2, n.dense(), n.observed_words());
+  log.append(index, 1, o.dense(), o.observed_words());
   SemanticMap loaded(params_);
   ASSERT_TRUE(log.load(index, loaded));
-  EXPECT_TRUE(std::equal(n.evidence().begin(), n.evidence().end(),
-                         loaded.find_block(index)->evidence().begin()));
+  EXPECT_EQ(n.dense(), loaded.find_block(index)->dense());
 }
 
 TEST_F(BlockLogTest, CompactionKeepsTheLatestCopiesAndShrinksTheFile) {

@@ -223,8 +223,7 @@ TEST(MapPager, EvictsBeyondRadiusPlusABlockAndRestoresWithinTheRadius) {
   // Two blocks towards +x: block 6 is 3.2 m away and comes back with its evidence.
   pager.update(centre_of_block_0 + 2 * one_block);
   ASSERT_TRUE(resident(map, 6));
-  const auto evidence = map.find_block({6, 0, 0})->evidence();
-  EXPECT_EQ(std::vector<float>(evidence.begin(), evidence.end()), row_evidence(params, 6));
+  EXPECT_EQ(map.find_block({6, 0, 0})->dense(), row_evidence(params, 6));
   EXPECT_EQ(pager.stats().restored, 1u);
   fs::remove_all(dir);
 }
@@ -239,7 +238,7 @@ TEST(MapPager, PagesInTheBlocksOfAResumedLog) {
     add_row(before, 0, 9);
     BlockLog log(dir / "map.log", params, false);
     before.for_each_block([&](const common::BlockIndex& index, const Block& block) {
-      log.append(index, 1, block.evidence(), block.observed_words());
+      log.append(index, 1, block.dense(), block.observed_words());
     });
     log.commit(1);
   }
@@ -253,8 +252,7 @@ TEST(MapPager, PagesInTheBlocksOfAResumedLog) {
   EXPECT_EQ(pager.paged_out(), 7u);
   for (int i = 0; i <= 2; ++i) {
     ASSERT_TRUE(resident(map, i)) << "block " << i;
-    const auto evidence = map.find_block({i, 0, 0})->evidence();
-    EXPECT_EQ(std::vector<float>(evidence.begin(), evidence.end()), row_evidence(params, i));
+    EXPECT_EQ(map.find_block({i, 0, 0})->dense(), row_evidence(params, i));
   }
   fs::remove_all(dir);
 }

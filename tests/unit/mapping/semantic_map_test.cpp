@@ -39,8 +39,9 @@ std::map<CellKey, std::vector<float>> all_cells(const SemanticMap& map) {
       const CellKey key{static_cast<int>(std::floor(centre.x() / map.params().resolution)),
                         static_cast<int>(std::floor(centre.y() / map.params().resolution)),
                         static_cast<int>(std::floor(centre.z() / map.params().resolution))};
-      const auto e = block.cell_evidence(c);
-      out[key] = std::vector<float>(e.begin(), e.end());
+      std::vector<float> e(static_cast<std::size_t>(block.channels()));
+      block.read_cell(c, e);
+      out[key] = e;
     }
   });
   return out;
@@ -56,7 +57,8 @@ TEST(SemanticMap, SinglePointAddsKernelTimesYToCellsWithinEll) {
   map.for_each_block([&](const common::BlockIndex& index, const Block& block) {
     for (int c = 0; c < block.num_cells(); ++c) {
       const double d = (map.cell_center(index, c) - p).cast<double>().norm();
-      const auto e = block.cell_evidence(c);
+      std::vector<float> e(static_cast<std::size_t>(block.channels()));
+      block.read_cell(c, e);
       EXPECT_NEAR(e[2], kernel(d), 1e-5 * params.sf2);
       EXPECT_EQ(e[0], 0.0f);
       EXPECT_EQ(e[1], 0.0f);
@@ -192,7 +194,9 @@ TEST_P(ThreadInvariance, MultiThreadedEqualsSingleThreadedBitForBit) {
   one.for_each_block([&](const common::BlockIndex& index, const Block& a) {
     const Block* b = two.find_block(index);
     ASSERT_NE(b, nullptr);
-    ASSERT_EQ(std::memcmp(a.evidence().data(), b->evidence().data(), a.evidence().size_bytes()), 0);
+    const std::vector<float> x = a.dense();
+    const std::vector<float> y = b->dense();
+    ASSERT_EQ(std::memcmp(x.data(), y.data(), x.size() * sizeof(float)), 0);
     for (int c = 0; c < a.num_cells(); ++c) ASSERT_EQ(a.observed(c), b->observed(c));
     ++compared;
   });
@@ -210,15 +214,17 @@ TEST(SemanticMap, AddingBlockEvidenceMergesMaps) {
   first.insert(scans[0], scans[0].origin);
   second.insert(scans[1], scans[1].origin);
   second.for_each_block([&](const common::BlockIndex& index, const Block& b) {
-    first.add_evidence(index, b.evidence());
+    first.add_evidence(index, b.dense());
   });
   EXPECT_EQ(first.stats().blocks, both.stats().blocks);
   EXPECT_EQ(first.stats().observed_cells, both.stats().observed_cells);
   both.for_each_block([&](const common::BlockIndex& index, const Block& b) {
     const Block* m = first.find_block(index);
     ASSERT_NE(m, nullptr);
-    for (std::size_t i = 0; i < b.evidence().size(); ++i) {
-      ASSERT_NEAR(m->evidence()[i], b.evidence()[i], 1e-4f * (1.0f + b.evidence()[i]));
+    const std::vector<float> merged = m->dense();
+    const std::vector<float> want = b.dense();
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      ASSERT_NEAR(merged[i], want[i], 1e-4f * (1.0f + want[i]));
     }
   });
 }

@@ -79,7 +79,7 @@ TEST(Merge, NewerCopyOfASourceReplacesTheOlderOne) {
   LayeredMap a = robot_map(1, 41);
   LayeredMap b(a.params());
   EvidenceGrid newer = *a.find_layer(1);
-  newer.cell({0, 0, 0})[0] = 1.0f;
+  testing::set_channel(newer, {0, 0, 0}, 0, 1.0f);
   newer.set_updates(newer.updates() + 1);
   b.set_layer(1, newer);
   const MergeReport report = merge_into(a, b, Eigen::Isometry3d::Identity());
@@ -92,9 +92,8 @@ TEST(Merge, ResamplingMovesEvidenceWithTheTransform) {
   LayeredMap b(p);
   // A single labelled cell in B's frame.
   const Eigen::Vector3d in_b(0.45, 0.15, 0.05);
-  auto cell = b.layer(2).cell(p.grid().cell_of(in_b));
-  cell[0] = 2.0f;
-  cell[3] = 5.0f;
+  testing::set_channel(b.layer(2), p.grid().cell_of(in_b), 0, 2.0f);
+  testing::set_channel(b.layer(2), p.grid().cell_of(in_b), 3, 5.0f);
   b.layer(2).set_updates(1);
   LayeredMap a(p);
   const Eigen::Isometry3d T_ab = rotated_translated();
@@ -108,7 +107,7 @@ TEST(Merge, ResamplingMovesEvidenceWithTheTransform) {
   EXPECT_FLOAT_EQ(f[3], 5.0f);
   std::size_t cells = 0;
   a.find_layer(2)->for_each_block([&](const common::BlockIndex&, const Block& block) {
-    const auto evidence = block.evidence();
+    const std::vector<float> evidence = block.dense();
     for (std::size_t i = 0; i < evidence.size(); i += 5) cells += evidence[i] != 0.0f;
   });
   EXPECT_GE(cells, 1u);
@@ -124,9 +123,9 @@ TEST(Merge, DirichletMapsAddEvidence) {
   LayeredMap b(p);
   const common::CellIndex cell(3, -1, 2);
   // alpha_A = (0.5, 2.5, 0.5), alpha_B = (1.5, 0.5, 3.5).
-  a.layer(1).cell(cell)[1] = 2.0f;
-  b.layer(2).cell(cell)[0] = 1.0f;
-  b.layer(2).cell(cell)[2] = 3.0f;
+  testing::set_channel(a.layer(1), cell, 1, 2.0f);
+  testing::set_channel(b.layer(2), cell, 0, 1.0f);
+  testing::set_channel(b.layer(2), cell, 2, 3.0f);
   a.layer(1).set_updates(1);
   b.layer(2).set_updates(1);
   merge_into(a, b, Eigen::Isometry3d::Identity());

@@ -47,12 +47,13 @@ LayeredMap big_map(int side, float value) {
   LayeredMap map(testing::small_logodds_params());
   EvidenceGrid& grid = map.layer(1);
   const int n = map.params().cells_per_side();
+  std::vector<float> cell(static_cast<std::size_t>(grid.channels()), 0.0f);
   for (int x = 0; x < side; ++x) {
     for (int y = 0; y < side; ++y) {
       for (int z = 0; z < side; ++z) {
         for (int c = 0; c < n * n * n; ++c) {
-          grid.cell({x * n + c % n, y * n + (c / n) % n, z * n + c / (n * n)})[0] =
-              value + static_cast<float>(x - y + z + c) * 0.01f;
+          cell[0] = value + static_cast<float>(x - y + z + c) * 0.01f;
+          grid.set_cell({x * n + c % n, y * n + (c / n) % n, z * n + c / (n * n)}, cell);
         }
       }
     }

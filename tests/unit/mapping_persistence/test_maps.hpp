@@ -1,11 +1,21 @@
 #pragma once
 
 #include <random>
+#include <vector>
 
 #include "semap/mapping/layered_map.hpp"
 #include "semap/mapping/logodds_map.hpp"
 
 namespace semap::mapping::testing {
+
+// Sets one channel of a cell, creating its block and marking the cell observed.
+inline void set_channel(EvidenceGrid& grid, const common::CellIndex& cell, int channel,
+                        float value) {
+  std::vector<float> values(static_cast<std::size_t>(grid.channels()));
+  grid.read_cell(cell, values);
+  values[static_cast<std::size_t>(channel)] = value;
+  grid.set_cell(cell, values);
+}
 
 inline MapParams small_logodds_params() {
   MapParams p;

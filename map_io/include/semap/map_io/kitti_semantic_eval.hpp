@@ -35,6 +35,12 @@ struct KittiSemanticConfig {
   // implementation queries each scan again after each of the next 10 inserts; the last query
   // counts). Scans within lag of the end are scored in the final map.
   std::size_t query_lag = 10;
+  // > 0: each map pages like the robot's (map.memory_radius_m, mapping::MapPager): before each
+  // insert, blocks farther than this from the scan's origin go to a block log in page_dir
+  // (<method>.log, created, not synced) and come back when the car returns. Points scored while
+  // their blocks are paged out count as unknown to the map.
+  double memory_radius_m = 0.0;
+  std::filesystem::path page_dir;
 };
 
 // One map's figures.
@@ -43,6 +49,8 @@ struct KittiMapResult {
   mapping::ConfusionMatrix confusion{kKittiClasses};
   std::vector<double> insert_seconds;  // per inserted scan: training set and fusion
   mapping::MapStats stats;
+  std::uint64_t paged_out = 0;  // blocks evicted to the log over the run (memory_radius_m)
+  std::uint64_t paged_in = 0;   // and brought back
 };
 
 struct KittiSemanticResult {

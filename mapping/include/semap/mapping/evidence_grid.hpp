@@ -8,7 +8,6 @@
 
 #include "semap/common/map_grid.hpp"
 #include "semap/mapping/block.hpp"
-#include "semap/mapping/block_arena.hpp"
 #include "semap/mapping/voxel_hash_map.hpp"
 
 namespace semap::mapping {
@@ -21,7 +20,7 @@ namespace semap::mapping {
 // Blocks are found through an open-addressing table (coordinates within +-2^20 blocks) and keep
 // their address while others are added, so the insertion engine can write many blocks in
 // parallel once it has created them. A pager may evict a block (written elsewhere first) and
-// restore it later; its storage is reused by the next block created.
+// restore it later.
 class EvidenceGrid {
  public:
   EvidenceGrid(int block_side, int channels);
@@ -47,10 +46,11 @@ class EvidenceGrid {
   const Block* find_block(const common::BlockIndex& key) const;
   Block* find_block(const common::BlockIndex& key);
 
-  // Channels of one cell, creating its block and marking the cell observed.
-  std::span<float> cell(const common::CellIndex& cell);
-  // Channels of one cell, or an empty span when its block is not in memory.
-  std::span<const float> find(const common::CellIndex& cell) const;
+  // Reads the channels of one cell into `out` (channels() floats); false, with `out` zeroed,
+  // when its block is not in memory.
+  bool read_cell(const common::CellIndex& cell, std::span<float> out) const;
+  // Replaces the channels of one cell, creating its block and marking the cell observed.
+  void set_cell(const common::CellIndex& cell, std::span<const float> values);
 
   // Adds `evidence` (block_floats() values) to the block at `key`, creating it; cells given a
   // non-zero value become observed. Throws std::invalid_argument for a wrong count or range.
@@ -62,10 +62,6 @@ class EvidenceGrid {
                      std::span<const std::uint64_t> observed);
   // Drops the block at `key` from memory; false when it is not in memory.
   bool evict(const common::BlockIndex& key);
-  // Storage for `blocks` more blocks in one piece: a map that will grow large asks for it at
-  // once (a huge-page mapping, address space only until blocks are written), a small one
-  // (a file read, a merge) does not. Throws std::bad_alloc when the system refuses.
-  void reserve(std::size_t blocks);
 
   // Calls f(const common::BlockIndex&, const Block&) for every block in memory, in the order
   // they were first created.
@@ -78,8 +74,7 @@ class EvidenceGrid {
   std::vector<common::BlockIndex> keys() const;
   std::size_t size() const { return blocks_.size() - evicted_; }  // blocks in memory
   std::size_t evicted() const { return evicted_; }
-  // Heap bytes: blocks, their observed bits, the arena (with storage kept for reuse) and the
-  // block table.
+  // Heap bytes: the blocks (their entries and observed bits) and the block table.
   std::size_t bytes() const;
 
   // Number of scans integrated into this grid; orders two copies of one robot's evidence
@@ -92,18 +87,14 @@ class EvidenceGrid {
 
  private:
   void check_block(const common::BlockIndex& key, std::span<const float> evidence) const;
-  // Zeroed evidence storage for one block: an evicted block's, or fresh from the arena.
-  float* new_storage();
 
   int block_side_;
   int channels_;
   std::uint64_t updates_ = 0;
   VoxelHashMap table_{16};                // block key -> position in blocks_ (grows)
   std::vector<common::BlockIndex> keys_;  // per position
-  BlockArena arena_;                      // before blocks_: they borrow its storage
   std::deque<Block> blocks_;              // a deque: references stay valid as blocks are added
   std::vector<std::uint8_t> resident_;    // per position: 0 once evicted
-  std::vector<float*> spare_storage_;     // storage of evicted blocks, for reuse
   std::size_t evicted_ = 0;
 };
 

@@ -12,6 +12,7 @@
 #include "semap/common/map_grid.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/mapping/block.hpp"
+#include "semap/mapping/cell_reading.hpp"
 #include "semap/mapping/evidence_grid.hpp"
 #include "semap/mapping/kernel.hpp"
 #include "semap/mapping/layered_map.hpp"
@@ -99,7 +100,7 @@ class SemanticMap {
   InsertResult insert(const TrainingSet& training);
 
   // The cell containing `point`; nullopt outside allocated blocks.
-  std::optional<common::CellPosterior> query(const Eigen::Vector3f& point) const;
+  std::optional<CellReading> query(const Eigen::Vector3f& point) const;
   // Class at `point`: the argmax, or -1 where the map is unknown.
   int label_at(const Eigen::Vector3f& point) const;
 
@@ -111,11 +112,12 @@ class SemanticMap {
   // Calls f(const Eigen::Vector3f& centre, const common::CellPosterior&) for every observed cell.
   template <typename F>
   void for_each_cell(F&& f) const {
+    std::vector<float> evidence(static_cast<std::size_t>(params_.num_classes));
     for_each_block([&](const common::BlockIndex& index, const Block& block) {
       for (int c = 0; c < block.num_cells(); ++c) {
         if (!block.observed(c)) continue;
-        f(cell_center(index, c),
-          common::CellPosterior(block.cell_evidence(c), params_.prior, true));
+        block.read_cell(c, evidence);
+        f(cell_center(index, c), common::CellPosterior(evidence, params_.prior, true));
       }
     });
   }
