@@ -301,7 +301,11 @@ void Estimator::correct_with_heading(double heading_deg, common::Stamp stamp) {
   }
   const double yaw = wrap_angle(std::numbers::pi / 2.0 - heading_deg * std::numbers::pi / 180.0 +
                                 config_.gnss_heading_offset_rad);
-  const double var = config_.gnss_heading_sigma_rad * config_.gnss_heading_sigma_rad;
+  // The fix's stamp is its read time, not its epoch's: turning, that error is a yaw error (H2).
+  const NavState x = filter_->state();
+  const double yaw_rate = last_imu_ ? (x.rotation * (last_imu_->gyro - x.gyro_bias)).z() : 0.0;
+  const double late = yaw_rate * config_.gnss_heading_latency_s;
+  const double var = config_.gnss_heading_sigma_rad * config_.gnss_heading_sigma_rad + late * late;
   const CorrectionResult r = filter_->correct_yaw(yaw, var, heading_gate2_);
   if (r.accepted) {
     ++counters_.heading_applied;

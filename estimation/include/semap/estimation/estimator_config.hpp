@@ -64,6 +64,9 @@ struct EstimatorConfig {
   // the receiver reports when the body x axis points north.
   double gnss_heading_sigma_rad = 0.5 * std::numbers::pi / 180.0;
   double gnss_heading_offset_rad = 0.0;
+  // How far a fix's stamp (its GGA's read time) may be from the epoch it measured: while the
+  // robot turns at yaw rate w the heading's variance grows by (w * this)^2 (H2).
+  double gnss_heading_latency_s = 0.1;
   // IMU samples are held this long before integration so that late GNSS fixes still fit
   // in time order; the estimate lags by the same amount.
   double imu_delay_s = 0.0;
