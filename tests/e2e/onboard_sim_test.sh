@@ -15,8 +15,8 @@
 # - both late-joining listeners received the whole map: every block, and the same occupied
 #   cells with the same classes as the map saved at SIGTERM (agreement);
 # - the first map blocks are ready within 6 s of the process's start: the simulated receiver's
-#   dual-antenna heading (rig.gnss_heading) makes the heading known at rest (about 2.5 s on a
-#   quiet machine); without it mapping waits until driving has shown the heading (~16 s);
+#   dual-antenna heading (rig.gnss_heading) makes the heading known at rest (1.9-2.5 s at load
+#   5-7, up to 4 s at load 8-10); without it mapping waits until driving has shown it (~16 s);
 # - the robot's own health figures hold: it initialised, perception turned the camera frames
 #   into posed clouds and the map took (nearly) every one, the listener saw no rejected
 #   blocks and plausible rt/semap/health reports.
