@@ -185,7 +185,7 @@ TEST(OnboardConfig, MapHoldKeys) {
       "  start_heading_sigma_deg: 3 ", "  hold_seconds: -1\n  start_heading_sigma_deg: 3 "));
   EXPECT_NE(negative.find("map.hold_seconds"), std::string::npos) << negative;
   EXPECT_NE(negative.find("semap_onboard_config_"), std::string::npos) << negative;
-  EXPECT_NE(negative.find(":62"), std::string::npos) << negative;
+  EXPECT_NE(negative.find(":65"), std::string::npos) << negative;
   const std::string sigma =
       error_of(edited_sim("  start_heading_sigma_deg: 3 ",
                           "  hold_heading_sigma_deg: 0\n  start_heading_sigma_deg: 3 "));
