@@ -78,6 +78,7 @@ void print_text(const GnssFix& f) {
     std::printf(" vel_enu %.3f %.3f %.3f m/s", f.velocity_enu->x(), f.velocity_enu->y(),
                 f.velocity_enu->z());
   }
+  if (f.heading_deg) std::printf(" heading %.2f deg", *f.heading_deg);
   std::printf("\n");
 }
 
@@ -98,10 +99,11 @@ void print_json(const GnssFix& f) {
   }
   std::printf(
       "{\"class\":\"FIX\",\"time\":%s,\"lat\":%s,\"lon\":%s,\"alt_hae\":%s,\"mode\":\"%s\","
-      "\"sats\":%u,\"h_acc\":%s,\"v_acc\":%s,\"vel_enu\":%s}\n",
+      "\"sats\":%u,\"h_acc\":%s,\"v_acc\":%s,\"vel_enu\":%s,\"heading\":%s}\n",
       time.c_str(), num(f.latitude_deg, 9).c_str(), num(f.longitude_deg, 9).c_str(),
       num(f.altitude_m, 4).c_str(), mode_name(f.mode), static_cast<unsigned>(f.satellites),
-      num(h_acc(f), 3).c_str(), num(v_acc(f), 3).c_str(), vel.c_str());
+      num(h_acc(f), 3).c_str(), num(v_acc(f), 3).c_str(), vel.c_str(),
+      f.heading_deg ? num(*f.heading_deg, 2).c_str() : "null");
 }
 
 struct Counter {

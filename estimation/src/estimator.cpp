@@ -33,6 +33,7 @@ std::unique_ptr<NavFilter> make_filter(FilterKind kind, const FilterParams& para
 Estimator::Estimator(const EstimatorConfig& config)
     : config_(config),
       gate2_(chi_square_quantile(config.gating_probability, 3.0)),
+      heading_gate2_(chi_square_quantile(config.gating_probability, 1.0)),
       filter_(make_filter(config.filter, config.params, config.covariance_window)),
       validator_(config.imu_limits),
       gnss_buffer_(config.gnss_buffer),
@@ -284,6 +285,41 @@ void Estimator::correct_with_gnss(const common::GnssFix& fix) {
         filter_->correct_velocity(*fix.velocity_enu, Matrix3d::Identity() * var, gate2_);
     ++(rv.accepted ? counters_.velocity_applied : counters_.velocity_rejected);
   }
+  if (fix.heading_deg) correct_with_heading(*fix.heading_deg, fix.stamp);
+}
+
+// A dual-antenna receiver's true heading (clockwise from north, of its baseline) as the body's
+// ENU yaw (counter-clockwise from east): (H1) in docs/estimation.md. It makes the heading known
+// at rest, where motion cannot.
+void Estimator::correct_with_heading(double heading_deg, common::Stamp stamp) {
+  if (!std::isfinite(heading_deg) || heading_deg < 0.0 || heading_deg >= 360.0) {
+    ++counters_.heading_invalid;
+    common::logger("estimation")
+        ->debug("GNSS heading at {:.3f} s ignored: {} deg is not in [0, 360)", stamp.seconds(),
+                heading_deg);
+    return;
+  }
+  const double yaw = wrap_angle(std::numbers::pi / 2.0 - heading_deg * std::numbers::pi / 180.0 +
+                                config_.gnss_heading_offset_rad);
+  // The fix's stamp is its read time, not its epoch's: turning, that error is a yaw error (H2).
+  const NavState x = filter_->state();
+  const double yaw_rate = last_imu_ ? (x.rotation * (last_imu_->gyro - x.gyro_bias)).z() : 0.0;
+  const double late = yaw_rate * config_.gnss_heading_latency_s;
+  const double var = config_.gnss_heading_sigma_rad * config_.gnss_heading_sigma_rad + late * late;
+  const CorrectionResult r = filter_->correct_yaw(yaw, var, heading_gate2_);
+  if (r.accepted) {
+    ++counters_.heading_applied;
+    heading_gated_run_ = false;
+    return;
+  }
+  ++counters_.heading_rejected;
+  common::logger("estimation")
+      ->log(heading_gated_run_ ? spdlog::level::debug : spdlog::level::warn,
+            "GNSS heading at {:.3f} s gated out: Mahalanobis^2 {:.1f} >= {:.1f}, residual {:.2f} "
+            "deg",
+            stamp.seconds(), r.mahalanobis2, heading_gate2_,
+            r.residual.z() * 180.0 / std::numbers::pi);
+  heading_gated_run_ = true;
 }
 
 void Estimator::note_rejection(const Vector3d& residual) {

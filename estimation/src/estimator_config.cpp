@@ -54,6 +54,11 @@ EstimatorConfig load_estimator_config(const common::ConfigSection& s) {
   c.use_gnss_velocity = s.get<bool>("use_gnss_velocity", c.use_gnss_velocity);
   c.gnss_velocity_sigma_m_s =
       s.get_in_range("gnss_velocity_sigma", c.gnss_velocity_sigma_m_s, 1e-3, 10.0);
+  c.gnss_heading_sigma_rad =
+      s.get_in_range("gnss_heading_sigma_deg", c.gnss_heading_sigma_rad / kDeg, 0.01, 90.0) * kDeg;
+  c.gnss_heading_offset_rad = s.get_in_range("gnss_heading_offset_deg", 0.0, -180.0, 180.0) * kDeg;
+  c.gnss_heading_latency_s =
+      s.get_in_range("gnss_heading_latency_s", c.gnss_heading_latency_s, 0.0, 1.0);
   c.imu_limits.max_dt_s = s.get_in_range("imu_max_dt", c.imu_limits.max_dt_s, 1e-4, 1.0);
   c.imu_limits.max_gyro_rad_s =
       s.get_in_range("imu_max_gyro", c.imu_limits.max_gyro_rad_s, 1.0, 100.0);

@@ -74,4 +74,22 @@ KalmanUpdate joseph_update(Matrix15& covariance, const Eigen::Vector3d& innovati
   return out;
 }
 
+KalmanUpdate joseph_update(Matrix15& covariance, double innovation, const RowVector15& h,
+                           double noise, double gate2) {
+  KalmanUpdate out;
+  const Vector15 pht = covariance * h.transpose();
+  const double s = h.dot(pht) + noise;
+  if (!(s > 0.0)) return out;
+  out.mahalanobis2 = innovation * innovation / s;
+  if (!(out.mahalanobis2 < gate2)) return out;  // also rejects NaN
+  out.accepted = true;
+  const Vector15 k = pht / s;
+  out.delta = k * innovation;
+  // Joseph form as above: zero m up to rounding for the optimal gain.
+  const Vector15 m = k * s - pht;
+  covariance.noalias() += m * k.transpose() - k * pht.transpose();
+  covariance = (0.5 * (covariance + covariance.transpose())).eval();
+  return out;
+}
+
 }  // namespace semap::estimation

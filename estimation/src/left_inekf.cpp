@@ -166,6 +166,26 @@ CorrectionResult LeftInekf::correct_velocity(const Vector3d& velocity, const Mat
   return update_world(velocity - v_, h, covariance, gate2);
 }
 
+CorrectionResult LeftInekf::correct_yaw(double yaw, double variance, double gate2) {
+  // (H1)-(H3), docs/estimation.md: the residual wrapped to (-pi, pi], H in world form.
+  CorrectionResult out;
+  if (!yaw_defined(r_)) return out;
+  const double z = wrap_angle(yaw - yaw_of(r_));
+  out.residual.z() = z;
+  RowVector15 h = RowVector15::Zero();
+  h.segment<3>(kRot) = yaw_jacobian_world(r_);
+  settle();
+  Matrix15 p = p_.dense();
+  const KalmanUpdate u = joseph_update(p, z, h, variance, gate2);
+  out.accepted = u.accepted;
+  out.mahalanobis2 = u.mahalanobis2;
+  if (u.accepted) {
+    p_.set(p);
+    correct_world(u.delta);
+  }
+  return out;
+}
+
 CorrectionResult LeftInekf::update_world(const Vector3d& residual, const Matrix3x15& h,
                                          const Matrix3d& noise, double gate2) {
   CorrectionResult out;

@@ -83,6 +83,22 @@ CorrectionResult QuaternionEskf::correct_position(const Vector3d& position,
   return out;
 }
 
+CorrectionResult QuaternionEskf::correct_yaw(double yaw, double variance, double gate2) {
+  // Local rotation error R = R_hat exp([dtheta]x): H is the body-axis yaw Jacobian (H2).
+  CorrectionResult out;
+  const Matrix3d r = q_.toRotationMatrix();
+  if (!yaw_defined(r)) return out;
+  const double z = wrap_angle(yaw - yaw_of(r));
+  out.residual.z() = z;
+  RowVector15 h = RowVector15::Zero();
+  h.segment<3>(kRot) = yaw_jacobian_body(r);
+  const KalmanUpdate u = joseph_update(p_, z, h, variance, gate2);
+  out.accepted = u.accepted;
+  out.mahalanobis2 = u.mahalanobis2;
+  if (u.accepted) inject(u.delta);
+  return out;
+}
+
 CorrectionResult QuaternionEskf::correct_velocity(const Vector3d& velocity,
                                                   const Matrix3d& covariance, double gate2) {
   CorrectionResult out;

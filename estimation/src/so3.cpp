@@ -87,6 +87,18 @@ double yaw_of(const Eigen::Matrix3d& rotation) {
   return std::atan2(rotation(1, 0), rotation(0, 0));
 }
 
+bool yaw_defined(const Eigen::Matrix3d& rotation) { return std::abs(rotation(2, 0)) < 0.999999; }
+
+Eigen::RowVector3d yaw_jacobian_body(const Eigen::Matrix3d& rotation) {
+  const double r20 = rotation(2, 0);
+  return Eigen::RowVector3d(0.0, rotation(2, 1), rotation(2, 2)) / (1.0 - r20 * r20);
+}
+
+Eigen::RowVector3d yaw_jacobian_world(const Eigen::Matrix3d& rotation) {
+  const double r20 = rotation(2, 0);
+  return (Eigen::Vector3d::UnitZ() - r20 * rotation.col(0)).transpose() / (1.0 - r20 * r20);
+}
+
 Eigen::Matrix3d rotation_from_rpy(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
           Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *

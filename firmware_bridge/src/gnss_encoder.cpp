@@ -148,6 +148,12 @@ std::vector<std::string> encode_nmea_epoch(const common::GnssFix& fix, std::int6
   gst.alt_sd_m = std::sqrt(c(2, 2));
   ellipse_from_covariance(c, gst);
   append(semap_nmea_encode_gst(&gst, talker, buf.data(), buf.size()));
+  if (fix.heading_deg) {
+    SemapNmeaHeading hdt{};
+    hdt.has_heading = 1;
+    hdt.heading_deg = *fix.heading_deg;
+    append(semap_nmea_encode_heading(&hdt, SEMAP_NMEA_HDT, talker, buf.data(), buf.size()));
+  }
 
   SemapNmeaGga gga{};
   gga.has_time = 1;

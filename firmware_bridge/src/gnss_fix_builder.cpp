@@ -189,6 +189,19 @@ std::optional<common::GnssFix> GnssFixBuilder::add(const SemapNmeaSentence& sent
         vtg_ = sentence.u.vtg;
       }
       return std::nullopt;
+    case SEMAP_NMEA_HDT:
+    case SEMAP_NMEA_THS: {
+      // Only an autonomous heading measures the baseline (THS 'E' is dead reckoning).
+      const SemapNmeaHeading& h = sentence.u.heading;
+      if (!h.has_heading || h.mode != 'A') return std::nullopt;
+      // No time either: like VTG, one after a held GGA belongs to that epoch.
+      if (pending_ && !pending_->heading_deg) {
+        pending_->heading_deg = h.heading_deg;
+      } else {
+        heading_deg_ = h.heading_deg;
+      }
+      return std::nullopt;
+    }
     case SEMAP_NMEA_GGA:
       break;
   }
@@ -262,6 +275,8 @@ common::GnssFix GnssFixBuilder::build(const SemapNmeaGga& gga, common::Stamp sta
     apply_vtg(*vtg_, fix);
   }
   vtg_.reset();
+  fix.heading_deg = heading_deg_;
+  heading_deg_.reset();
   return fix;
 }
 

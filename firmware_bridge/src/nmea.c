@@ -188,9 +188,28 @@ static SemapFbResult parse_vtg(const Field* f, int n, SemapNmeaVtg* v) {
   return result(SEMAP_FB_OK, -1);
 }
 
+/* HDT: heading, 'T'. THS: heading, mode. A heading outside [0, 360) is a bad field. */
+static SemapFbResult parse_heading(const Field* f, int n, SemapNmeaType type, SemapNmeaHeading* h) {
+  if (n < 2) return bad(n);
+  memset(h, 0, sizeof *h);
+  if (!opt_decimal(f[0], &h->has_heading, &h->heading_deg) ||
+      (h->has_heading && !(h->heading_deg >= 0.0 && h->heading_deg < 360.0))) {
+    return bad(0);
+  }
+  if (type == SEMAP_NMEA_HDT) {
+    if (f[1].n != 1 || f[1].s[0] != 'T') return bad(1);
+    h->mode = h->has_heading ? 'A' : 'V';
+    return result(SEMAP_FB_OK, -1);
+  }
+  static const char kModes[] = "AEMSV";
+  if (f[1].n != 1 || !memchr(kModes, f[1].s[0], sizeof kModes - 1)) return bad(1);
+  h->mode = f[1].s[0];
+  return result(SEMAP_FB_OK, -1);
+}
+
 static int parse_talker(const char* s, SemapNmeaTalker* talker) {
-  static const char* const kTalkers[SEMAP_NMEA_TALKER_COUNT] = {"GP", "GN", "GL", "GA",
-                                                                "GB", "BD", "GQ", "GI"};
+  static const char* const kTalkers[SEMAP_NMEA_TALKER_COUNT] = {"GP", "GN", "GL", "GA", "GB",
+                                                                "BD", "GQ", "GI", "HE"};
   for (int i = 0; i < (int)SEMAP_NMEA_TALKER_COUNT; ++i) {
     if (s[0] == kTalkers[i][0] && s[1] == kTalkers[i][1]) {
       *talker = (SemapNmeaTalker)i;
@@ -201,8 +220,8 @@ static int parse_talker(const char* s, SemapNmeaTalker* talker) {
 }
 
 static int parse_type(const char* s, SemapNmeaType* type) {
-  static const char* const kTypes[] = {"GGA", "RMC", "GST", "VTG"};
-  for (int i = 0; i < 4; ++i) {
+  static const char* const kTypes[] = {"GGA", "RMC", "GST", "VTG", "HDT", "THS"};
+  for (int i = 0; i < 6; ++i) {
     if (memcmp(s, kTypes[i], 3) == 0) {
       *type = (SemapNmeaType)i;
       return 1;
@@ -258,6 +277,9 @@ SemapFbResult semap_nmea_parse(const char* text, size_t len, SemapNmeaSentence* 
       return parse_gst(fields, count, &out->u.gst);
     case SEMAP_NMEA_VTG:
       return parse_vtg(fields, count, &out->u.vtg);
+    case SEMAP_NMEA_HDT:
+    case SEMAP_NMEA_THS:
+      return parse_heading(fields, count, out->type, &out->u.heading);
   }
   return result(SEMAP_FB_UNKNOWN, -1);
 }

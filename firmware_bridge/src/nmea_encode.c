@@ -57,8 +57,8 @@ static void put_opt_fixed(Writer* w, uint8_t has, double v, int decimals) {
   put_char(w, ',');
 }
 
-static const char* const kTalkers[SEMAP_NMEA_TALKER_COUNT] = {"GP", "GN", "GL", "GA",
-                                                              "GB", "BD", "GQ", "GI"};
+static const char* const kTalkers[SEMAP_NMEA_TALKER_COUNT] = {"GP", "GN", "GL", "GA", "GB",
+                                                              "BD", "GQ", "GI", "HE"};
 
 static void begin(Writer* w, SemapNmeaTalker talker, const char* type) {
   if ((unsigned)talker >= SEMAP_NMEA_TALKER_COUNT) {
@@ -191,5 +191,22 @@ size_t semap_nmea_encode_vtg(const SemapNmeaVtg* in, SemapNmeaTalker talker, cha
   put_str(&w, "K,");
   if (in->mode) put_char(&w, in->mode);
   put_char(&w, ',');
+  return finish(&w);
+}
+
+size_t semap_nmea_encode_heading(const SemapNmeaHeading* in, SemapNmeaType type,
+                                 SemapNmeaTalker talker, char* buf, size_t cap) {
+  Writer w = {buf, cap, 0, 0};
+  if (type != SEMAP_NMEA_HDT && type != SEMAP_NMEA_THS) return 0;
+  begin(&w, talker, type == SEMAP_NMEA_HDT ? "HDT" : "THS");
+  /* What would round to 360.00 (put_fixed's rounding) is outside [0, 360): it is 0.00. */
+  const double h = in->heading_deg * 100.0 + 0.5 < 36000.0 ? in->heading_deg : 0.0;
+  put_opt_fixed(&w, in->has_heading, h, 2);
+  if (type == SEMAP_NMEA_HDT) {
+    put_str(&w, "T,");
+  } else {
+    put_char(&w, in->mode ? in->mode : 'V');
+    put_char(&w, ',');
+  }
   return finish(&w);
 }

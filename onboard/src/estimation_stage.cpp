@@ -138,8 +138,8 @@ void EstimationStage::share_smoothed(double yaw_sigma_deg) {
 double EstimationStage::position_sigma() {
   constexpr double kReadPeriodS = 0.05;
   const auto& counters = estimator_.counters();
-  const std::uint64_t corrections =
-      counters.gnss_applied + counters.velocity_applied + counters.position_inflations;
+  const std::uint64_t corrections = counters.gnss_applied + counters.velocity_applied +
+                                    counters.heading_applied + counters.position_inflations;
   const common::Stamp now = estimator_.filter_time();
   if (now >= next_sigma_read_ || corrections != sigma_read_at_corrections_) {
     position_sigma_m_ =

@@ -34,8 +34,13 @@ bool PerceptionStage::pose_clouds() {
   bool any = false;
   auto& figures = stage_.figures();
   while (!unposed_.empty()) {
-    const auto lookup = poses_.at(unposed_.front().cloud.stamp);
+    auto lookup = poses_.at(unposed_.front().cloud.stamp);
     if (lookup.status == SharedPoseHistory::Status::kPending) break;
+    // Stamped before the live poses but taken after the smoothed ones of those seconds were
+    // given (the heading known at once, from a dual-antenna receiver): its pose is a smoothed one.
+    if (lookup.status == SharedPoseHistory::Status::kTooOld && poses_.smoothed_given()) {
+      lookup = poses_.smoothed_at(unposed_.front().cloud.stamp);
+    }
     // Before the heading is known, and until the smoothed poses of those seconds are given. A
     // frame waiting for carried labels is not held: its segmentation's pose is not known either.
     if (lookup.status != SharedPoseHistory::Status::kPosed && hold_.enabled() &&

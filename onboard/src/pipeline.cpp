@@ -95,9 +95,12 @@ Pipeline::Pipeline(const OnboardConfig& config, const RigFactory& make_rig,
         if (!first_blocks_logged_ && !changed.empty()) {
           first_blocks_logged_ = true;
           common::logger("onboard")->info(
-              "first map blocks ({}) ready to publish {:.2f} s after start", changed.size(),
+              "first map blocks ({}) ready to publish {:.2f} s after start ({:.2f} s after the "
+              "process started)",
+              changed.size(),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - constructed_)
-                  .count());
+                  .count(),
+              common::process_age_seconds());
         }
         if (dds_) dds_->blocks_changed(changed, paged_out);
         for (PipelineObserver* o : observers_) o->on_mapped(changed);

@@ -10,6 +10,11 @@ void estimation_summary(const EstimationStageStats& est, std::vector<std::string
                   "initialised={}",
                   est.imu_samples, est.gnss_fixes, est.estimator.gnss_applied,
                   est.estimator.gnss_rejected, est.initialised ? "yes" : "no"));
+  const auto& e = est.estimator;
+  if (e.heading_applied + e.heading_rejected + e.heading_invalid > 0) {
+    lines.push_back(fmt::format("gnss heading     : {} applied, {} gated out, {} invalid",
+                                e.heading_applied, e.heading_rejected, e.heading_invalid));
+  }
 }
 
 void perception_summary(const PerceptionStage& perception, std::vector<std::string>& lines) {

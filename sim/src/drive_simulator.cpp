@@ -154,6 +154,15 @@ Motion motion_at(const Profile& p, const Kinematics& k, double t, const Vector3d
   return m;
 }
 
+// True heading of the body x axis (clockwise from north) plus `unit_noise` sigmas, [0, 360).
+double heading_deg(const Eigen::Matrix3d& rotation, const SimulatorConfig& c, double unit_noise) {
+  const Vector3d forward = rotation.col(0);
+  const double h = std::atan2(forward.x(), forward.y()) * 180.0 / std::numbers::pi +
+                   c.gnss_heading_sigma_deg * unit_noise;
+  const double wrapped = std::fmod(h, 360.0);
+  return wrapped < 0.0 ? wrapped + 360.0 : wrapped;
+}
+
 }  // namespace
 
 DriveData simulate(const SimulatorConfig& c) {
@@ -224,6 +233,7 @@ DriveData simulate(const SimulatorConfig& c) {
             if (c.gnss_velocity) {
               fix.velocity_enu = mg.state.velocity + c.gnss_velocity_sigma_m_s * gaussian3();
             }
+            if (c.gnss_heading) fix.heading_deg = heading_deg(mg.state.rotation, c, normal(rng));
             out.gnss.push_back(fix);
           }
         }

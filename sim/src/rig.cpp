@@ -123,8 +123,12 @@ void SimRig::set_taps(onboard::RawTaps taps) {
 }
 
 void SimRig::start() {
-  // Whole microseconds, the resolution of a candump log: a recorded run replays exactly.
-  start_ = common::Stamp(((common::Stamp::now() + 0.2).ns / 1000) * 1000);
+  // The drive's first event is played 0.2 s from now; its stamps start at 1 s (0 means
+  // "unset"), so start_, the wall time of drive time 0, lies before that: waiting out that
+  // second delayed every sensor, and the first map, by a second. Whole microseconds, the
+  // resolution of a candump log: a recorded run replays exactly.
+  const std::int64_t first_ns = data_.truth.empty() ? 0 : data_.truth.front().stamp.ns;
+  start_ = common::Stamp(((common::Stamp::now() + 0.2).ns - first_ns) / 1000 * 1000);
   drivers_.start();
   camera_->start();
   thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
@@ -192,15 +196,15 @@ void SimRig::run(std::stop_token stop) {
   const double camera_period = camera_period_s_;
   const double camera_ahead = camera_->request_ahead_s();
   // Asked for ahead, the first frames would be late already.
-  double next_camera =
-      data_.truth.empty() ? 0.0 : data_.truth.front().stamp.seconds() + camera_ahead;
+  const double first_s = data_.truth.empty() ? 0.0 : data_.truth.front().stamp.seconds();
+  double next_camera = first_s + camera_ahead;
   sim::VectorSource source(data_.imu, data_.gnss);
   std::size_t imu_index = 0;
   while (!stop.stop_requested()) {
     auto event = source.next();
     if (!event) break;
     const common::Stamp sim_stamp = std::visit([](const auto& e) { return e.stamp; }, *event);
-    if (sim_stamp.seconds() > duration) break;
+    if (sim_stamp.seconds() - first_s > duration) break;
     const common::Stamp wall(start_.ns + sim_stamp.ns);
     onboard::sleep_until(wall, stop);
     if (std::holds_alternative<common::ImuSample>(*event)) {

@@ -17,6 +17,12 @@ void read_keys(const ConfigSection& s, SimRigConfig& rig) {
   t.imu_rate_hz = s.get_in_range("imu_rate_hz", 200.0, 50.0, 1000.0);
   t.gnss_rate_hz = s.get_in_range("gnss_rate_hz", 10.0, 1.0, 20.0);
   t.gnss_sigma_m = s.get_in_range("gnss_sigma_m", 0.5, 0.01, 10.0);
+  t.gnss_heading = s.get<bool>("gnss_heading", false);
+  t.gnss_heading_sigma_deg =
+      s.get_in_range("gnss_heading_sigma_deg", t.gnss_heading_sigma_deg, 0.01, 30.0);
+  if (s.has("gnss_heading_sigma_deg") && !t.gnss_heading) {
+    s.reject("gnss_heading_sigma_deg", "needs gnss_heading: true (the receiver's heading)");
+  }
   t.static_s = s.get_in_range("static_s", 3.0, 1.0, 60.0);
   t.seed = static_cast<std::uint64_t>(s.get<int>("seed", 1));
   rig.scene_seed = static_cast<std::uint32_t>(s.get<int>("scene_seed", 7));
@@ -60,6 +66,9 @@ onboard::RigKeys sim_rig_keys(SimRigConfig& out) {
     if (out.faults.can_bus_off_s > 0.0 && c.imu.interface.empty()) {
       rig.section_or_empty("faults").reject("can_bus_off_at_s",
                                             "needs imu.interface: a CAN bus to go bus-off");
+    }
+    if (out.trajectory.gnss_heading && c.gnss.protocol == firmware_bridge::GnssProtocol::kUbx) {
+      rig.reject("gnss_heading", "the emulator sends a heading as NMEA HDT only (gnss.protocol)");
     }
     if (c.rig.kind == onboard::RigKind::kSim && c.depth.source != onboard::DepthSource::kAligned) {
       root.section_or_empty("depth").reject("source",

@@ -247,6 +247,25 @@ TEST(GnssFixBuilder, FallsBackToHdopAndVtg) {
   EXPECT_FALSE(next->velocity_enu);
 }
 
+TEST(GnssFixBuilder, DualAntennaHeadingGoesWithTheNextGgaOnly) {
+  GnssFixBuilder builder;
+  const std::string gga = "$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47";
+  EXPECT_FALSE(builder.add(parse("$GPHDT,123.456,T*32"), common::Stamp(1)));
+  auto fix = builder.add(parse(gga), common::Stamp(2));
+  ASSERT_TRUE(fix && fix->heading_deg);
+  EXPECT_DOUBLE_EQ(*fix->heading_deg, 123.456);
+  // The heading belonged to that epoch; a single-antenna epoch has none.
+  fix = builder.add(parse(gga), common::Stamp(3));
+  ASSERT_TRUE(fix);
+  EXPECT_FALSE(fix->heading_deg);
+  // THS from dead reckoning ('E') or without a heading measures no baseline.
+  builder.add(parse("$GNTHS,77.52,E*2A"), common::Stamp(4));
+  builder.add(parse("$GNHDT,,T*05"), common::Stamp(5));
+  fix = builder.add(parse(gga), common::Stamp(6));
+  ASSERT_TRUE(fix);
+  EXPECT_FALSE(fix->heading_deg);
+}
+
 common::GnssFix truth() {
   common::GnssFix fix;
   fix.stamp = common::Stamp(1'000'000'000);
@@ -288,6 +307,27 @@ TEST(GnssEncoder, NmeaEpochRoundTripsThroughTheStreamDecoder) {
   ASSERT_TRUE(out.utc_ns);
   EXPECT_EQ(*out.utc_ns, (1'767'225'600'000 + 45'296'700) * 1'000'000LL);
   EXPECT_EQ(out.mode, common::FixMode::kRtkFloat);
+  EXPECT_FALSE(out.heading_deg);
+}
+
+TEST(GnssEncoder, NmeaEpochCarriesADualAntennaHeadingAsHdt) {
+  common::GnssFix in = truth();
+  in.heading_deg = 301.25;
+  const std::vector<std::string> sentences =
+      encode_nmea_epoch(in, 1'767'225'600'000, SEMAP_NMEA_TALKER_GN);
+  ASSERT_EQ(sentences.size(), 5u);
+  EXPECT_EQ(sentences[3], "$GNHDT,301.25,T*" + sentences[3].substr(16, 2) + "\r\n");
+  GnssStreamDecoder decoder;
+  std::vector<common::GnssFix> fixes;
+  for (const std::string& s : sentences) {
+    decoder.feed({reinterpret_cast<const std::uint8_t*>(s.data()), s.size()}, common::Stamp(9),
+                 fixes);
+  }
+  ASSERT_EQ(fixes.size(), 1u);
+  ASSERT_TRUE(fixes[0].heading_deg);
+  EXPECT_DOUBLE_EQ(*fixes[0].heading_deg, 301.25);
+  EXPECT_EQ(decoder.counters().nmea_sentences, 5u);
+  EXPECT_EQ(decoder.counters().bad_field + decoder.counters().unknown, 0u);
 }
 
 TEST(GnssEncoder, UbxEpochRoundTrips) {

@@ -68,7 +68,7 @@ TEST(Nmea, ParsesRealRmcVtgAndGst) {
 }
 
 TEST(Nmea, AcceptsEveryListedTalkerAndRejectsOthers) {
-  const char* talkers[] = {"GP", "GN", "GL", "GA", "GB", "BD", "GQ", "GI"};
+  const char* talkers[] = {"GP", "GN", "GL", "GA", "GB", "BD", "GQ", "GI", "HE"};
   ASSERT_EQ(std::size(talkers), std::size_t{SEMAP_NMEA_TALKER_COUNT});
   for (int i = 0; i < SEMAP_NMEA_TALKER_COUNT; ++i) {
     SemapNmeaSentence s;
@@ -148,6 +148,69 @@ TEST(Nmea, ReportsTheIndexOfABadField) {
   r = parse(with_checksum("$GPGGA,123519,4807.038,N,01131.000,E,1"), s);
   EXPECT_EQ(r.status, SEMAP_FB_BAD_FIELD);
   EXPECT_EQ(r.field, 6) << "missing fields are reported at the first absent index";
+}
+
+TEST(Nmea, ParsesDualAntennaHeadingFromHdtAndThs) {
+  SemapNmeaSentence s;
+  // The HDT example of the NMEA 0183 references (gpsd's among them), checksum as printed.
+  ASSERT_EQ(parse("$GPHDT,123.456,T*32\r\n", s).status, SEMAP_FB_OK);
+  ASSERT_EQ(s.type, SEMAP_NMEA_HDT);
+  EXPECT_TRUE(s.u.heading.has_heading);
+  EXPECT_DOUBLE_EQ(s.u.heading.heading_deg, 123.456);
+  EXPECT_EQ(s.u.heading.mode, 'A');
+  ASSERT_EQ(parse(with_checksum("$HEHDT,274.07,T"), s).status, SEMAP_FB_OK);
+  EXPECT_EQ(s.talker, SEMAP_NMEA_TALKER_HE);
+  EXPECT_DOUBLE_EQ(s.u.heading.heading_deg, 274.07);
+  // No heading yet (the receiver has not resolved its baseline): empty, not an error.
+  ASSERT_EQ(parse(with_checksum("$GNHDT,,T"), s).status, SEMAP_FB_OK);
+  EXPECT_FALSE(s.u.heading.has_heading);
+  EXPECT_EQ(s.u.heading.mode, 'V');
+  ASSERT_EQ(parse("$GNTHS,77.52,E*2A", s).status, SEMAP_FB_OK);
+  ASSERT_EQ(s.type, SEMAP_NMEA_THS);
+  EXPECT_DOUBLE_EQ(s.u.heading.heading_deg, 77.52);
+  EXPECT_EQ(s.u.heading.mode, 'E');
+}
+
+TEST(Nmea, HeadingErrorsNameTheField) {
+  SemapNmeaSentence s;
+  // One character changed after the checksum was taken.
+  EXPECT_EQ(parse("$GPHDT,123.457,T*32", s).status, SEMAP_FB_BAD_CHECKSUM);
+  for (const char* body : {"$GPHDT,360.00,T", "$GPHDT,-0.5,T", "$GPHDT,12a.4,T", "$GNTHS,400,A"}) {
+    const SemapFbResult r = parse(with_checksum(body), s);
+    EXPECT_EQ(r.status, SEMAP_FB_BAD_FIELD) << body;
+    EXPECT_EQ(r.field, 0) << body << ": the heading";
+  }
+  for (const char* body : {"$GPHDT,123.4,M", "$GPHDT,123.4,", "$GNTHS,123.4,X", "$GNTHS,1.0,AA"}) {
+    const SemapFbResult r = parse(with_checksum(body), s);
+    EXPECT_EQ(r.status, SEMAP_FB_BAD_FIELD) << body;
+    EXPECT_EQ(r.field, 1) << body << ": 'T' or the mode";
+  }
+  const SemapFbResult r = parse(with_checksum("$GPHDT,123.4"), s);
+  EXPECT_EQ(r.status, SEMAP_FB_BAD_FIELD);
+  EXPECT_EQ(r.field, 1) << "the missing field";
+}
+
+TEST(Nmea, HeadingEncodersRoundTripThroughTheParser) {
+  char buf[SEMAP_NMEA_MAX_LENGTH + 1];
+  SemapNmeaHeading h{};
+  h.has_heading = 1;
+  h.heading_deg = 359.996;  // rounds to 360.00 at two decimals: written as 0.00
+  std::size_t n =
+      semap_nmea_encode_heading(&h, SEMAP_NMEA_HDT, SEMAP_NMEA_TALKER_GN, buf, sizeof buf);
+  ASSERT_GT(n, 0u);
+  EXPECT_STREQ(buf, "$GNHDT,0.00,T*1B\r\n");
+  SemapNmeaSentence s;
+  ASSERT_EQ(semap_nmea_parse(buf, n, &s).status, SEMAP_FB_OK) << buf;
+  EXPECT_EQ(s.u.heading.heading_deg, 0.0);
+  h.heading_deg = 81.234;
+  h.mode = 'A';
+  n = semap_nmea_encode_heading(&h, SEMAP_NMEA_THS, SEMAP_NMEA_TALKER_GP, buf, sizeof buf);
+  ASSERT_EQ(semap_nmea_parse(buf, n, &s).status, SEMAP_FB_OK) << buf;
+  EXPECT_EQ(s.type, SEMAP_NMEA_THS);
+  EXPECT_DOUBLE_EQ(s.u.heading.heading_deg, 81.23);
+  EXPECT_EQ(s.u.heading.mode, 'A');
+  EXPECT_EQ(semap_nmea_encode_heading(&h, SEMAP_NMEA_GGA, SEMAP_NMEA_TALKER_GP, buf, sizeof buf),
+            0u);
 }
 
 TEST(Nmea, EmptyFieldsMeanNoFix) {

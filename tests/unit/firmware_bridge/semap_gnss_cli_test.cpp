@@ -85,12 +85,13 @@ TEST(SemapGnssCli, JsonPerFixMatchesGpsdAndEndsWithEveryCounter) {
   for (std::size_t i = 0; i + 1 < out.size(); ++i) {
     const std::string& fix = out[i];
     ASSERT_EQ(field(fix, "class"), "FIX") << fix;
-    for (const char* key :
-         {"time", "lat", "lon", "alt_hae", "mode", "sats", "h_acc", "v_acc", "vel_enu"}) {
+    for (const char* key : {"time", "lat", "lon", "alt_hae", "mode", "sats", "h_acc", "v_acc",
+                            "vel_enu", "heading"}) {
       EXPECT_FALSE(field(fix, key).empty()) << key << " missing: " << fix;
     }
     EXPECT_EQ(field(fix, "mode"), "3d");
     EXPECT_EQ(field(fix, "vel_enu").front(), '[');
+    EXPECT_EQ(field(fix, "heading"), "null");  // one antenna
     const auto it = gpsd.find(field(fix, "time"));
     if (it == gpsd.end()) continue;  // the first epoch, which gpsd does not report
     ++matched;

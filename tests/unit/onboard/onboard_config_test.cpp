@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 
 #include "semap/common/config.hpp"
 #include "semap/onboard/dds_outputs.hpp"
@@ -185,7 +186,7 @@ TEST(OnboardConfig, MapHoldKeys) {
       "  start_heading_sigma_deg: 3 ", "  hold_seconds: -1\n  start_heading_sigma_deg: 3 "));
   EXPECT_NE(negative.find("map.hold_seconds"), std::string::npos) << negative;
   EXPECT_NE(negative.find("semap_onboard_config_"), std::string::npos) << negative;
-  EXPECT_NE(negative.find(":62"), std::string::npos) << negative;
+  EXPECT_NE(negative.find(":65"), std::string::npos) << negative;
   const std::string sigma =
       error_of(edited_sim("  start_heading_sigma_deg: 3 ",
                           "  hold_heading_sigma_deg: 0\n  start_heading_sigma_deg: 3 "));
@@ -370,6 +371,24 @@ TEST(OnboardConfig, SimulatedRigFaults) {
   const std::string hardware = error_of(edited_sim(
       "  kind: sim\n", "  kind: hardware\n  faults: {gnss_silent_at_s: 1, gnss_silent_s: 1}\n"));
   EXPECT_NE(hardware.find("only the simulated rig injects faults"), std::string::npos) << hardware;
+}
+
+// The simulated receiver's dual-antenna heading: on in sim.yaml, sent as NMEA HDT only.
+TEST(OnboardConfig, SimulatedReceiversHeading) {
+  sim::SimRigConfig sim_rig;
+  const auto c = load(kConfigDir / "sim.yaml", &sim_rig);
+  EXPECT_TRUE(sim_rig.trajectory.gnss_heading);
+  EXPECT_DOUBLE_EQ(sim_rig.trajectory.gnss_heading_sigma_deg, 0.3);
+  EXPECT_NEAR(c.estimator.gnss_heading_sigma_rad, 0.5 * std::numbers::pi / 180.0, 1e-15);
+  const std::string ubx = error_of(edited_sim("  protocol: nmea", "  protocol: ubx"));
+  EXPECT_NE(ubx.find("'rig.gnss_heading': the emulator sends a heading as NMEA HDT only"),
+            std::string::npos)
+      << ubx;
+  const std::string sigma_alone =
+      error_of(edited_sim("  gnss_heading: true ", "  gnss_heading: false "));
+  EXPECT_NE(sigma_alone.find("'rig.gnss_heading_sigma_deg': needs gnss_heading: true"),
+            std::string::npos)
+      << sigma_alone;
 }
 
 // `dnn` names any network OpenCV reads; `onnx`, the only format once, stays a name for it.

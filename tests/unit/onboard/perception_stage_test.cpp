@@ -219,6 +219,27 @@ TEST_F(PerceptionStageTest, HoldsFramesBeforeTheFirstPosesAndMapsThemAtTheirStam
   EXPECT_EQ(s.clouds + s.without_pose, s.frames);
 }
 
+// With the heading known at once (a dual-antenna receiver) the smoothed poses come with the
+// first live ones: a frame stamped before those but taken after takes its smoothed pose.
+TEST_F(PerceptionStageTest, AFrameFromBeforeTheLivePosesTakesItsSmoothedPose) {
+  auto stage = make_stage(0.0, HoldBuffer(10.0, std::size_t{64} << 20));
+  poses_.set_smoothed(drive(1.0, 2.0));
+  poses_.append(drive(2.0, 3.0));
+  push_pair(1.5, 1);  // stamped before the live poses, taken after
+  while (stage->step()) {
+  }
+  push_pair(0.5, 2);  // before the smoothed seconds too
+  while (stage->step()) {
+  }
+  LabeledCloud cloud;
+  ASSERT_TRUE(clouds_.try_pop(cloud));
+  EXPECT_NEAR(cloud.origin.x() - camera_.mount_xyz.x(), 3.0f, 1e-3f);  // x = 2 t
+  EXPECT_FALSE(clouds_.try_pop(cloud));
+  const auto s = stage->stats();
+  EXPECT_EQ(s.clouds, 1u);
+  EXPECT_EQ(s.without_pose, 1u);  // the frame at 0.5 s
+}
+
 TEST_F(PerceptionStageTest, CountsHeldFramesLeftWhenItStops) {
   auto stage = make_stage(0.0, HoldBuffer(10.0, std::size_t{64} << 20));
   push_pair(0.5, 1);

@@ -31,6 +31,34 @@ SimulatorConfig noiseless(Scenario scenario) {
   return c;
 }
 
+// A dual-antenna receiver's heading: the body x axis's true heading, clockwise from north,
+// in [0, 360), with the configured noise.
+TEST(Simulator, GnssHeadingIsTheTrueHeadingWithItsNoise) {
+  SimulatorConfig c;
+  c.duration_s = 60.0;
+  c.gnss_heading = true;
+  c.gnss_heading_sigma_deg = 0.3;
+  const DriveData d = simulate(c);
+  double sum2 = 0.0;
+  std::size_t n = 0;
+  std::size_t t = 0;
+  for (const auto& fix : d.gnss) {
+    ASSERT_TRUE(fix.heading_deg);
+    ASSERT_GE(*fix.heading_deg, 0.0);
+    ASSERT_LT(*fix.heading_deg, 360.0);
+    while (t + 1 < d.truth.size() && d.truth[t + 1].stamp <= fix.stamp) ++t;
+    // Between IMU samples: the nearer truth sample, at most 2.5 ms away.
+    const double yaw = yaw_of(d.truth[t].state.rotation);
+    const double error = wrap_angle((90.0 - *fix.heading_deg) * std::numbers::pi / 180.0 - yaw);
+    sum2 += error * error;
+    ++n;
+  }
+  ASSERT_GT(n, 500u);
+  EXPECT_NEAR(std::sqrt(sum2 / static_cast<double>(n)) * 180.0 / std::numbers::pi, 0.3, 0.05);
+  c.gnss_heading = false;
+  EXPECT_FALSE(simulate(c).gnss.front().heading_deg);
+}
+
 // Dead reckoning on noise-free IMU samples must reproduce the truth: the samples and the
 // ground truth come from the same motion.
 TEST(Simulator, ImuIntegratesToTruth) {

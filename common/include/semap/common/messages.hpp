@@ -55,6 +55,10 @@ struct GnssFix {
   // seconds), when it reported both date and time: GGA time with the date of RMC, NAV-PVT date
   // and time with validDate and validTime set.
   std::optional<std::int64_t> utc_ns;
+  // True heading of the receiver's antenna baseline, degrees clockwise from true north in
+  // [0, 360), when a dual-antenna (moving-base) receiver reported one in the fix's epoch
+  // (NMEA HDT, or THS in autonomous mode). Single-antenna receivers have none.
+  std::optional<double> heading_deg;
 
   bool valid() const { return quality != FixQuality::kInvalid; }
 };

@@ -6,5 +6,8 @@ namespace semap::common {
 // largest resident set, in MiB.
 double process_cpu_seconds();
 double process_peak_rss_mib();
+// Seconds since this process started (its start time in /proc/self/stat, 10 ms resolution
+// on Linux's usual 100 ticks per second); negative when that cannot be read.
+double process_age_seconds();
 
 }  // namespace semap::common

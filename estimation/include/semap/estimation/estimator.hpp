@@ -27,6 +27,10 @@ struct EstimatorCounters {
   std::uint64_t gnss_rejected = 0;  // failed the chi-square gate
   std::uint64_t velocity_applied = 0;
   std::uint64_t velocity_rejected = 0;
+  // Dual-antenna headings (GnssFix::heading_deg): applied, failed the gate, not a heading.
+  std::uint64_t heading_applied = 0;
+  std::uint64_t heading_rejected = 0;
+  std::uint64_t heading_invalid = 0;
   std::uint64_t reanchors = 0;
   // Of those, back to a frame used before (a multipath jump that ended): that frame restored.
   std::uint64_t reanchors_back = 0;
@@ -73,6 +77,7 @@ class Estimator {
   common::Stamp filter_time() const { return filter_time_; }
   const NavFilter& filter() const { return *filter_; }
   double gate2() const { return gate2_; }
+  double heading_gate2() const { return heading_gate2_; }
 
   // Records the Left-InEKF's forward pass from its initialisation on, the last `max_seconds`
   // of it, for smoothed_poses() (InekfRtsSmoother; the quaternion ESKF records nothing). The
@@ -93,6 +98,7 @@ class Estimator {
   void try_initialise();
   void apply_gnss(const common::GnssFix& fix);
   void correct_with_gnss(const common::GnssFix& fix);
+  void correct_with_heading(double heading_deg, common::Stamp stamp);
   void propagate(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, double dt);
   void note_rejection(const Eigen::Vector3d& residual);
   void record_pose();
@@ -100,6 +106,7 @@ class Estimator {
 
   EstimatorConfig config_;
   double gate2_;
+  double heading_gate2_;  // 1 dof
   std::unique_ptr<NavFilter> filter_;
   ImuValidator validator_;
   GnssReorderBuffer gnss_buffer_;
@@ -117,6 +124,7 @@ class Estimator {
   std::optional<common::ImuSample> last_imu_;  // the newest sample integrated
   std::vector<Eigen::Vector3d> rejected_run_;  // residuals of consecutive gated-out fixes
   int consecutive_rejections_ = 0;
+  bool heading_gated_run_ = false;            // the last heading was gated out (warn once per run)
   std::optional<InekfRtsSmoother> smoother_;  // while recording for smoothing
 };
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <numbers>
 #include <optional>
 
 #include "semap/common/config.hpp"
@@ -58,6 +59,14 @@ struct EstimatorConfig {
   Eigen::Vector3d lever_arm = Eigen::Vector3d::Zero();  // GNSS antenna in the body frame, m
   bool use_gnss_velocity = false;
   double gnss_velocity_sigma_m_s = 0.1;
+  // A dual-antenna receiver's heading (GnssFix::heading_deg): its sigma, and the heading of
+  // its baseline in the body frame (clockwise from the body x axis, seen from above), which
+  // the receiver reports when the body x axis points north.
+  double gnss_heading_sigma_rad = 0.5 * std::numbers::pi / 180.0;
+  double gnss_heading_offset_rad = 0.0;
+  // How far a fix's stamp (its GGA's read time) may be from the epoch it measured: while the
+  // robot turns at yaw rate w the heading's variance grows by (w * this)^2 (H2).
+  double gnss_heading_latency_s = 0.1;
   // IMU samples are held this long before integration so that late GNSS fixes still fit
   // in time order; the estimate lags by the same amount.
   double imu_delay_s = 0.0;

@@ -11,6 +11,7 @@ struct CorrectionResult {
   bool accepted = false;
   double mahalanobis2 = 0.0;                           // squared Mahalanobis distance
   Eigen::Vector3d residual = Eigen::Vector3d::Zero();  // measured - predicted, world frame
+                                                       // (yaw: about the world z axis, rad)
 };
 
 // The interface both filters share, so the estimator front-end, the evaluation and the
@@ -31,6 +32,9 @@ class NavFilter {
   // Velocity of the body origin in the world frame.
   virtual CorrectionResult correct_velocity(const Eigen::Vector3d& velocity,
                                             const Eigen::Matrix3d& covariance, double gate2) = 0;
+  // Yaw of the body (yaw_of: the body x axis from east, counter-clockwise, rad), e.g. from a
+  // dual-antenna receiver, with its variance (rad^2); gate2 is a 1-dof chi-square bound.
+  virtual CorrectionResult correct_yaw(double yaw, double variance, double gate2) = 0;
 
   // Adds world-frame covariances to the position and velocity uncertainty (recovery from a
   // filter that has become overconfident and gates out every fix).

@@ -23,6 +23,7 @@ class QuaternionEskf final : public NavFilter {
                                     const Eigen::Vector3d& lever_arm, double gate2) override;
   CorrectionResult correct_velocity(const Eigen::Vector3d& velocity,
                                     const Eigen::Matrix3d& covariance, double gate2) override;
+  CorrectionResult correct_yaw(double yaw, double variance, double gate2) override;
 
   void inflate(const Eigen::Matrix3d& position_covariance,
                const Eigen::Matrix3d& velocity_covariance) override;

@@ -34,6 +34,14 @@ Eigen::Vector3d so3_log(const Eigen::Matrix3d& rotation);
 
 // Yaw (rotation about ENU z) of a body-to-world rotation with the ZYX convention.
 double yaw_of(const Eigen::Matrix3d& rotation);
+// Its derivative with respect to a rotation error in body axes, R exp([phi]x):
+// (0, r21, r22) / (1 - r20^2) (docs/estimation.md (H2)); undefined when the body x axis is
+// vertical (r20 = +-1).
+bool yaw_defined(const Eigen::Matrix3d& rotation);  // |r20| < 0.999999: pitch within ~89.9 deg
+Eigen::RowVector3d yaw_jacobian_body(const Eigen::Matrix3d& rotation);
+// And in world axes, exp([phi]x) R: yaw_jacobian_body(R) R^T = (e_z - r20 R e_x)^T / (1 - r20^2)
+// (H3).
+Eigen::RowVector3d yaw_jacobian_world(const Eigen::Matrix3d& rotation);
 
 // Rz(yaw) Ry(pitch) Rx(roll): body (FLU) to world (ENU).
 Eigen::Matrix3d rotation_from_rpy(double roll, double pitch, double yaw);

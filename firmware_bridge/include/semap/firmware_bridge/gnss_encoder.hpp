@@ -10,9 +10,9 @@
 
 namespace semap::firmware_bridge {
 
-// Sentences of one NMEA epoch for a fix, in receiver order: RMC, VTG, GST, GGA (each with
-// CR LF). `utc_unix_ms` is the epoch's UTC time. Covariance becomes the GST ellipse and
-// sigmas; altitude is written as MSL with zero geoid separation.
+// Sentences of one NMEA epoch for a fix, in receiver order: RMC, VTG, GST, HDT (when the fix
+// has a heading), GGA (each with CR LF). `utc_unix_ms` is the epoch's UTC time. Covariance becomes
+// the GST ellipse and sigmas; altitude is written as MSL with zero geoid separation.
 std::vector<std::string> encode_nmea_epoch(const common::GnssFix& fix, std::int64_t utc_unix_ms,
                                            SemapNmeaTalker talker);
 

@@ -26,7 +26,9 @@ struct GnssFixBuilderConfig {
 
 // Combines the sentences of one NMEA epoch into a GnssFix. The fix is emitted on GGA, with the
 // covariance of the latest GST (same UTC time, or not older than gst_max_age_s), the velocity
-// of an RMC with the same UTC time or a VTG received since the previous GGA, and the UTC time of
+// of an RMC with the same UTC time or a VTG received since the previous GGA, the heading of an
+// HDT or autonomous THS received since the previous GGA (neither has a time: one a receiver
+// sends after its GGA goes with the next epoch's fix, a period late), and the UTC time of
 // GGA on the date of the latest RMC (a day later or earlier when GGA's time of day wrapped).
 // With `wait_for_gst`, a receiver that sends GST after GGA is learned from its first epoch:
 // from then on GGA is held until the GST of its time (a VTG in between gives the velocity), or
@@ -49,6 +51,7 @@ class GnssFixBuilder {
   common::GnssFix build(const SemapNmeaGga& gga, common::Stamp stamp);
 
   std::optional<SemapNmeaVtg> vtg_;         // cleared at every GGA
+  std::optional<double> heading_deg_;       // HDT / THS since the last GGA, cleared at it
   std::optional<common::GnssFix> pending_;  // a GGA's fix waiting for the GST of its time
   std::int32_t pending_time_ms_ = -1;
   std::int32_t last_gga_time_ms_ = -1;

@@ -1,4 +1,4 @@
-/* NMEA 0183 GGA, RMC, GST and VTG: parser with checksum and length checks, and encoders.
+/* NMEA 0183 GGA, RMC, GST, VTG, HDT and THS: parser with checksum and length checks, and encoders.
  * Plain C99, no allocation, no locale-dependent number parsing. */
 #ifndef SEMAP_FIRMWARE_BRIDGE_NMEA_H
 #define SEMAP_FIRMWARE_BRIDGE_NMEA_H
@@ -29,6 +29,7 @@ typedef enum SemapNmeaTalker {
   SEMAP_NMEA_TALKER_BD,     /* BeiDou (older receivers, e.g. ST Teseo) */
   SEMAP_NMEA_TALKER_GQ,     /* QZSS */
   SEMAP_NMEA_TALKER_GI,     /* NavIC (IRNSS) */
+  SEMAP_NMEA_TALKER_HE,     /* heading sensor: dual-antenna receivers' HDT (e.g. Hemisphere) */
   SEMAP_NMEA_TALKER_COUNT
 } SemapNmeaTalker;
 
@@ -36,7 +37,9 @@ typedef enum SemapNmeaType {
   SEMAP_NMEA_GGA = 0,
   SEMAP_NMEA_RMC,
   SEMAP_NMEA_GST,
-  SEMAP_NMEA_VTG
+  SEMAP_NMEA_VTG,
+  SEMAP_NMEA_HDT,
+  SEMAP_NMEA_THS
 } SemapNmeaType;
 
 /* Empty fields are legal in NMEA; each optional value has a has_ flag. Time of day is UTC in
@@ -80,6 +83,17 @@ typedef struct SemapNmeaVtg {
   char mode;
 } SemapNmeaVtg;
 
+/* True heading of a dual-antenna (moving-base) receiver's baseline, or of a gyrocompass:
+ * HDT "$xxHDT,hhh.hh,T" and THS "$xxTHS,hhh.hh,m". Degrees clockwise from true north in
+ * [0, 360). HDT has no status: an empty heading means none. THS's mode: 'A' autonomous,
+ * 'E' estimated (dead reckoning), 'M' manual, 'S' simulator, 'V' not valid; HDT reads as 'A'
+ * when it has a heading. Neither carries a time: a receiver sends them in its epoch. */
+typedef struct SemapNmeaHeading {
+  uint8_t has_heading;
+  double heading_deg;
+  char mode;
+} SemapNmeaHeading;
+
 typedef struct SemapNmeaSentence {
   SemapNmeaTalker talker;
   SemapNmeaType type;
@@ -88,6 +102,7 @@ typedef struct SemapNmeaSentence {
     SemapNmeaRmc rmc;
     SemapNmeaGst gst;
     SemapNmeaVtg vtg;
+    SemapNmeaHeading heading; /* HDT and THS */
   } u;
 } SemapNmeaSentence;
 
@@ -107,6 +122,9 @@ size_t semap_nmea_encode_gga(const SemapNmeaGga* in, SemapNmeaTalker talker, cha
 size_t semap_nmea_encode_rmc(const SemapNmeaRmc* in, SemapNmeaTalker talker, char* buf, size_t cap);
 size_t semap_nmea_encode_gst(const SemapNmeaGst* in, SemapNmeaTalker talker, char* buf, size_t cap);
 size_t semap_nmea_encode_vtg(const SemapNmeaVtg* in, SemapNmeaTalker talker, char* buf, size_t cap);
+/* HDT (the mode is not written) or THS (mode 'V' when in->mode is 0), by `type`. */
+size_t semap_nmea_encode_heading(const SemapNmeaHeading* in, SemapNmeaType type,
+                                 SemapNmeaTalker talker, char* buf, size_t cap);
 
 #ifdef __cplusplus
 }

@@ -38,6 +38,10 @@ struct SimulatorConfig {
   double gnss_sigma_m = 1.0;               // per axis
   bool gnss_velocity = false;
   double gnss_velocity_sigma_m_s = 0.1;
+  // A dual-antenna receiver's heading with each fix (the baseline along the body x axis):
+  // the true heading plus white noise of this sigma, degrees.
+  bool gnss_heading = false;
+  double gnss_heading_sigma_deg = 0.3;
   double dropouts_per_minute = 0.0;
   double dropout_duration_s = 5.0;
   std::vector<GnssJump> jumps;
