@@ -171,11 +171,18 @@ void MappingStage::run(std::stop_token stop) {
 }
 
 void MappingStage::insert(const common::LabeledCloud& cloud) {
+  // A cloud older than one already mapped was held from before the heading was known
+  // (PerceptionStage): late on purpose, it would only hide the live latency.
+  const bool live = cloud.stamp >= newest_mapped_;
   const auto t0 = std::chrono::steady_clock::now();
+  if (live) taken_age_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
   mapping::InsertResult result;
   std::vector<common::BlockIndex> paged_out;
   {
     std::unique_lock lock(map_mutex_);
+    if (live)
+      lock_wait_.record(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     if (pager_) paged_out = pager_->update(cloud.origin);
     result = map_.insert(cloud, cloud.origin);
     if (pager_) {
@@ -189,9 +196,7 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
   if (checkpoint_) checkpoint_->after_insert(result);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // A cloud older than one already mapped was held from before the heading was known
-  // (PerceptionStage): late on purpose, it would only hide the live latency.
-  if (cloud.stamp >= newest_mapped_) {
+  if (live) {
     newest_mapped_ = cloud.stamp;
     latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
   }

@@ -36,7 +36,7 @@ cv::Mat paint_classes(const cv::Mat& train_ids) {
 SimCameraFeed::SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOptions& camera,
                              SimCameraImage image, float depth_scale,
                              common::SpscRing<common::ImageFrame>& colour_ring,
-                             common::SpscRing<common::ImageFrame>& depth_ring,
+                             common::SpscRing<common::ImageFrame>& depth_ring, double period_s,
                              SimCameraOutput output)
     : world_(world),
       camera_(camera),
@@ -44,6 +44,7 @@ SimCameraFeed::SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOpt
       depth_scale_(depth_scale),
       colour_ring_(colour_ring),
       depth_ring_(depth_ring),
+      period_s_(period_s),
       output_(std::move(output)) {}
 
 SimCameraFeed::~SimCameraFeed() { stop(); }
@@ -70,7 +71,7 @@ void SimCameraFeed::request(const Eigen::Isometry3f& world_from_optical, common:
 }
 
 double SimCameraFeed::request_ahead_s() const {
-  return output_.device ? output_.period_s + output_lead_s() : 0.0;
+  return output_.device ? output_.period_s + output_lead_s() : period_s_;
 }
 
 std::optional<cv::Mat> SimCameraFeed::true_labels(std::uint32_t sequence) const {
@@ -132,15 +133,20 @@ void SimCameraFeed::run(std::stop_token stop) {
 void SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
                             std::stop_token stop) {
   const cv::Mat colour = image_ == SimCameraImage::kRgb ? frame.bgr : paint_classes(frame.labels);
+  common::ImageFrame depth = drivers::to_frame(sim::depth_to_z16(frame.depth_m, depth_scale_),
+                                               common::PixelFormat::kZ16, stamp, sequence);
   if (!output_.device) {
-    colour_ring_.try_push(drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+    common::ImageFrame bgr =
+        drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence);
+    if (!wait_until(stamp, stop)) return;
+    delivery_age_.record(common::seconds_between(common::Stamp::now(), stamp));
+    colour_ring_.try_push(std::move(bgr));
   } else if (!show(colour, stamp, stop)) {
     std::lock_guard lock(mutex_);
     ++not_shown_;
     return;
   }
-  depth_ring_.try_push(drivers::to_frame(sim::depth_to_z16(frame.depth_m, depth_scale_),
-                                         common::PixelFormat::kZ16, stamp, sequence));
+  depth_ring_.try_push(std::move(depth));
 }
 
 // Writes the frame to the output `period - tolerance` before its stamp (see SimCameraOutput);
@@ -149,13 +155,7 @@ bool SimCameraFeed::show(const cv::Mat& colour, common::Stamp stamp, std::stop_t
   const common::Stamp due = stamp + (-output_lead_s());
   const double allowance = output_.period_s - 2.0 * output_.tolerance_s;
   if (common::Stamp::now() > due + 0.5 * allowance) return false;
-  {
-    std::unique_lock lock(mutex_);
-    const auto wait = std::chrono::nanoseconds(
-        std::max<std::int64_t>(0, static_cast<std::int64_t>(due.ns - common::Stamp::now().ns)));
-    wake_.wait_for(lock, stop, wait, [] { return false; });
-  }
-  if (stop.stop_requested()) return false;
+  if (!wait_until(due, stop)) return false;
   try {
     if (output_.device->write({colour.data, colour.total() * colour.elemSize()}, colour.step,
                               100)) {
@@ -166,6 +166,14 @@ bool SimCameraFeed::show(const cv::Mat& colour, common::Stamp stamp, std::stop_t
     common::logger("sim_camera")->warn("camera frame not shown: {}", e.what());
   }
   return false;
+}
+
+bool SimCameraFeed::wait_until(common::Stamp due, std::stop_token stop) {
+  std::unique_lock lock(mutex_);
+  const auto wait = std::chrono::nanoseconds(
+      std::max<std::int64_t>(0, static_cast<std::int64_t>(due.ns - common::Stamp::now().ns)));
+  wake_.wait_for(lock, stop, wait, [] { return false; });
+  return !stop.stop_requested();
 }
 
 }  // namespace semap::sim

@@ -72,6 +72,11 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   const common::LatencyWindow& latency() const { return latency_; }
   // Time each insert took.
   const common::LatencyWindow& insert_time() const { return insert_time_; }
+  // Where the age comes from before the insert: each live cloud's age (its image's capture
+  // stamp) when the stage takes it from its ring, and how long the insert then waited for the
+  // map's lock (the publisher's readers).
+  const common::LatencyWindow& taken_age() const { return taken_age_; }
+  const common::LatencyWindow& lock_wait() const { return lock_wait_; }
   // The map's blocks as the publisher sends them; safe from any thread. A paged-out block is
   // read from the checkpoint log; for_each_block lists the blocks in memory.
   const dds_idl::BlockSource& blocks() const { return *this; }
@@ -119,6 +124,8 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
   common::LatencyWindow latency_;
   common::Stamp newest_mapped_;  // clouds older than this were held back: not in latency_
+  common::LatencyWindow taken_age_;
+  common::LatencyWindow lock_wait_;
   common::LatencyWindow insert_time_;
   std::unique_ptr<WriteFailureLog> write_log_;  // with a checkpoint
   StageThread<MappingStageStats> stage_;        // last: joined before the members it uses
