@@ -67,10 +67,12 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   void start(std::vector<int> cpus = {});
   void stop();
   MappingStageStats stats() const;
-  // Age of each cloud (its image's capture stamp) once it is in the map; clouds held from
-  // before the heading was known (older than one already mapped) are left out.
+  // Age of each cloud (its image's capture stamp) once its cells are in the map (readable by
+  // the publisher); clouds held from before the heading was known (older than one already
+  // mapped) are left out.
   const common::LatencyWindow& latency() const { return latency_; }
-  // Time each insert took.
+  // Time each insert took, from taking the cloud (its wait for the map's lock included) until
+  // its cells are in the map.
   const common::LatencyWindow& insert_time() const { return insert_time_; }
   // Where the age comes from before the insert: each live cloud's age (its image's capture
   // stamp) when the stage takes it from its ring, and how long the insert then waited for the

@@ -47,7 +47,8 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
 // stage's). Ages: `frame_taken` (perception takes it from the camera ring), `cloud_out` (its
 // posed cloud goes into the cloud ring), `cloud_taken` (the mapping stage takes it), `in_map`.
 // Durations: `segment`, `points` (back-projection), `pose_wait` (until the filter reaches the
-// stamp), `lock_wait` (the map's lock, held by the publisher's readers), `insert`.
+// stamp), `lock_wait` (the map's lock, held by the publisher's readers) and `insert` (with
+// its lock wait).
 struct LatencyPhase {
   std::string name;
   common::LatencyPercentiles ms;
