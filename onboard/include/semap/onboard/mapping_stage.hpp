@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -129,8 +130,9 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   common::LatencyWindow taken_age_;
   common::LatencyWindow lock_wait_;
   common::LatencyWindow insert_time_;
-  std::unique_ptr<WriteFailureLog> write_log_;  // with a checkpoint
-  StageThread<MappingStageStats> stage_;        // last: joined before the members it uses
+  std::chrono::steady_clock::time_point stats_taken_;  // figures().map last counted
+  std::unique_ptr<WriteFailureLog> write_log_;         // with a checkpoint
+  StageThread<MappingStageStats> stage_;               // last: joined before the members it uses
 };
 
 // The map's shape and its palette's class names and colours (0xRRGGBB), for MapInfo.
