@@ -1,5 +1,8 @@
 #include "semap/sim/camera_feed.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <opencv2/core.hpp>
@@ -37,7 +40,7 @@ SimCameraFeed::SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOpt
                              SimCameraImage image, float depth_scale,
                              common::SpscRing<common::ImageFrame>& colour_ring,
                              common::SpscRing<common::ImageFrame>& depth_ring, double period_s,
-                             SimCameraOutput output)
+                             SimCameraOutput output, int render_nice)
     : world_(world),
       camera_(camera),
       image_(image),
@@ -45,7 +48,8 @@ SimCameraFeed::SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOpt
       colour_ring_(colour_ring),
       depth_ring_(depth_ring),
       period_s_(period_s),
-      output_(std::move(output)) {}
+      output_(std::move(output)),
+      render_nice_(render_nice) {}
 
 SimCameraFeed::~SimCameraFeed() { stop(); }
 
@@ -103,6 +107,11 @@ double SimCameraFeed::render_seconds_mean() const {
 }
 
 void SimCameraFeed::run(std::stop_token stop) {
+  // Linux: the calling thread's nice value. A refusal only leaves it at the process's.
+  if (render_nice_ > 0 &&
+      setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), render_nice_) != 0) {
+    common::logger("sim_camera")->warn("renderer nice {} refused", render_nice_);
+  }
   std::uint32_t sequence = 0;
   while (true) {
     Request request;

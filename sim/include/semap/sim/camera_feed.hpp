@@ -49,13 +49,14 @@ struct SimCameraOutput {
 // pushed at it, as a camera hands over the image it took: rendering, which a camera does in
 // hardware, is then not part of the pipeline's latency unless it takes longer than a period (the
 // frame is pushed when done, its delay in delivery_age()). 0: rendered after the stamp.
+// `render_nice` (0..19) lowers the renderer thread's priority below the pipeline's threads.
 class SimCameraFeed {
  public:
   SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOptions& camera,
                 SimCameraImage image, float depth_scale,
                 common::SpscRing<common::ImageFrame>& colour_ring,
                 common::SpscRing<common::ImageFrame>& depth_ring, double period_s = 0.0,
-                SimCameraOutput output = {});
+                SimCameraOutput output = {}, int render_nice = 0);
   ~SimCameraFeed();
   SimCameraFeed(const SimCameraFeed&) = delete;
   SimCameraFeed& operator=(const SimCameraFeed&) = delete;
@@ -100,6 +101,7 @@ class SimCameraFeed {
   common::SpscRing<common::ImageFrame>& depth_ring_;
   double period_s_;
   SimCameraOutput output_;
+  int render_nice_;
   mutable std::mutex mutex_;
   std::condition_variable_any wake_;
   std::optional<Request> pending_;
