@@ -131,15 +131,19 @@ void SimCameraFeed::run(std::stop_token stop) {
       std::lock_guard lock(mutex_);
       truth_.emplace_back(sequence, frame.labels);
       if (truth_.size() > kTruthKept) truth_.pop_front();
+    }
+    // Rendered ahead for a stamp the run did not reach, the frame was never taken: not counted.
+    if (!publish(frame, request.stamp, sequence, stop)) return;
+    {
+      std::lock_guard lock(mutex_);
       ++rendered_;
       render_seconds_ += seconds;
     }
-    publish(frame, request.stamp, sequence, stop);
     ++sequence;
   }
 }
 
-void SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
+bool SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
                             std::stop_token stop) {
   const cv::Mat colour = image_ == SimCameraImage::kRgb ? frame.bgr : paint_classes(frame.labels);
   common::ImageFrame depth = drivers::to_frame(sim::depth_to_z16(frame.depth_m, depth_scale_),
@@ -147,15 +151,16 @@ void SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std
   if (!output_.device) {
     common::ImageFrame bgr =
         drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence);
-    if (!wait_until(stamp, stop)) return;
+    if (!wait_until(stamp, stop)) return false;
     delivery_age_.record(common::seconds_between(common::Stamp::now(), stamp));
     colour_ring_.try_push(std::move(bgr));
   } else if (!show(colour, stamp, stop)) {
     std::lock_guard lock(mutex_);
     ++not_shown_;
-    return;
+    return true;
   }
   depth_ring_.try_push(std::move(depth));
+  return true;
 }
 
 // Writes the frame to the output `period - tolerance` before its stamp (see SimCameraOutput);

@@ -86,7 +86,8 @@ class SimCameraFeed {
     common::Stamp stamp;
   };
   void run(std::stop_token stop);
-  void publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
+  // False when stopped before a frame for the rings was due: it never went out.
+  bool publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
                std::stop_token stop);
   bool show(const cv::Mat& colour, common::Stamp stamp, std::stop_token stop);
   // Sleeps until `due`; false when asked to stop.
