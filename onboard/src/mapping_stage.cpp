@@ -158,24 +158,33 @@ void MappingStage::run(std::stop_token stop) {
     if (!clouds_.try_pop(cloud)) {
       if (stop.stop_requested()) break;
       if (checkpoint_) checkpoint_->poll();
-      // A standing robot's checkpoint retries are reported too, twice a second.
-      if (checkpoint_ && ++idle % 100 == 0) {
+      // A standing robot's checkpoint retries are reported too, about twice a second.
+      if (checkpoint_ && ++idle % 500 == 0) {
         note_writes();
         stage_.share();
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      // Short: a cloud's wait here is part of its latency into the map.
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
       continue;
     }
     arena.execute([&] { insert(cloud); });
   }
+  stage_.figures().map = map_.stats();
+  stage_.share();
 }
 
 void MappingStage::insert(const common::LabeledCloud& cloud) {
+  // A cloud older than one already mapped was held from before the heading was known
+  // (PerceptionStage): late on purpose, it would only hide the live latency.
+  const bool live = cloud.stamp >= newest_mapped_;
   const auto t0 = std::chrono::steady_clock::now();
+  if (live) taken_age_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
   mapping::InsertResult result;
   std::vector<common::BlockIndex> paged_out;
+  std::chrono::steady_clock::time_point locked;
   {
     std::unique_lock lock(map_mutex_);
+    locked = std::chrono::steady_clock::now();
     if (pager_) paged_out = pager_->update(cloud.origin);
     result = map_.insert(cloud, cloud.origin);
     if (pager_) {
@@ -186,22 +195,27 @@ void MappingStage::insert(const common::LabeledCloud& cloud) {
     }
     for (const auto& index : result.updated_blocks) ++versions_[index];
   }
-  if (checkpoint_) checkpoint_->after_insert(result);
+  // The cloud's cells are in the map, readable by the publisher: what follows (the
+  // checkpoint's copy, the figures, telling the publisher) delays only the next cloud.
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // A cloud older than one already mapped was held from before the heading was known
-  // (PerceptionStage): late on purpose, it would only hide the live latency.
-  if (cloud.stamp >= newest_mapped_) {
+  if (live) {
     newest_mapped_ = cloud.stamp;
     latency_.record(common::seconds_between(common::Stamp::now(), cloud.stamp));
+    lock_wait_.record(std::chrono::duration<double>(locked - t0).count());
   }
+  if (checkpoint_) checkpoint_->after_insert(result);
   insert_time_.record(seconds);
   stage_.figures().scans++;
   stage_.figures().points += cloud.size();
   stage_.figures().blocks_changed += result.updated_blocks.size();
   stage_.figures().insert_seconds_total += seconds;
   stage_.figures().insert_seconds_max = std::max(stage_.figures().insert_seconds_max, seconds);
-  stage_.figures().map = map_.stats();
+  // Counting the map's cells walks every block: twice a second is enough for the figures.
+  if (std::chrono::steady_clock::now() - stats_taken_ >= std::chrono::milliseconds(500)) {
+    stage_.figures().map = map_.stats();
+    stats_taken_ = std::chrono::steady_clock::now();
+  }
   note_writes();
   if (sink_) sink_(result.updated_blocks, paged_out);
   stage_.share();

@@ -197,6 +197,7 @@ bool PerceptionStage::take_frames() {
   common::ImageFrame frame;
   const bool lidar = depth_.source == DepthSource::kLidar;
   while (colour_ring_.try_pop(frame)) {
+    taken_age_.record(common::seconds_between(common::Stamp::now(), frame.stamp));
     if (tap_) tap_(frame, false);
     colour_pending_.push_back(std::move(frame));
     if (!lidar) ++stage_.figures().frames;

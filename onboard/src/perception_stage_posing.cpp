@@ -27,7 +27,7 @@ void PerceptionStage::queue_for_pose(common::LabeledCloud body_cloud, common::St
     unposed_.pop_front();  // the filter has stalled; keep the newest
     ++stage_.figures().without_pose;
   }
-  unposed_.push_back(BodyCloud{std::move(body_cloud), sequence, {}});
+  unposed_.push_back(BodyCloud{std::move(body_cloud), sequence, common::Stamp::now(), {}});
 }
 
 bool PerceptionStage::pose_clouds() {
@@ -75,6 +75,8 @@ bool PerceptionStage::pose_clouds() {
       }
     }
     any = true;
+    const common::Stamp now = common::Stamp::now();
+    pose_wait_.record(common::seconds_between(now, unposed_.front().queued_at));
     common::LabeledCloud cloud =
         mapping::transform_cloud(std::move(unposed_.front().cloud), lookup.pose.world_from_body());
     unposed_.pop_front();

@@ -286,6 +286,7 @@ std::vector<std::string> Pipeline::summary() const {
   if (!rig_->gives_poses()) estimation_summary(estimation_->stats(), lines);
   if (perception_) perception_summary(*perception_, lines);
   mapping_summary(mapping_->stats(), checkpoint_path_, config_.map.memory_radius_m, lines);
+  latency_summary(latency_phases(perception_.get(), *mapping_), lines);
   for (const std::string& failure : save_failures_) {
     lines.push_back("map save failed  : " + failure);
   }

@@ -41,6 +41,23 @@ std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& e
   return figures;
 }
 
+std::vector<LatencyPhase> latency_phases(const PerceptionStage* perception,
+                                         const MappingStage& mapping) {
+  std::vector<LatencyPhase> phases;
+  if (perception) {
+    phases = {{"frame_taken", perception->taken_age().percentiles()},
+              {"segment", perception->segment_time().percentiles()},
+              {"points", perception->points_time().percentiles()},
+              {"pose_wait", perception->pose_wait().percentiles()},
+              {"cloud_out", perception->latency().percentiles()}};
+  }
+  phases.push_back({"cloud_taken", mapping.taken_age().percentiles()});
+  phases.push_back({"lock_wait", mapping.lock_wait().percentiles()});
+  phases.push_back({"insert", mapping.insert_time().percentiles()});
+  phases.push_back({"in_map", mapping.latency().percentiles()});
+  return phases;
+}
+
 std::string Progress::line(double t, const EstimationStageStats& est,
                            const PerceptionStageStats& perception, const MappingStageStats& map,
                            const Rings& r) {

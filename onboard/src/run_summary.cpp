@@ -85,6 +85,16 @@ void mapping_summary(const MappingStageStats& map, const std::filesystem::path& 
   }
 }
 
+void latency_summary(const std::vector<LatencyPhase>& phases, std::vector<std::string>& lines) {
+  std::string line;
+  for (const LatencyPhase& phase : phases) {
+    if (phase.ms.count == 0) continue;
+    line += fmt::format("{}{} {:.0f}/{:.0f}", line.empty() ? "" : ", ", phase.name,
+                        static_cast<double>(phase.ms.p50_ms), static_cast<double>(phase.ms.p99_ms));
+  }
+  if (!line.empty()) lines.push_back("latency p50/p99  : " + line + " ms");
+}
+
 void dds_summary(const DdsOutputs& dds, std::vector<std::string>& lines) {
   const auto m = dds.map_counters();
   lines.push_back(fmt::format(

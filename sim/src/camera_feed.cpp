@@ -1,5 +1,8 @@
 #include "semap/sim/camera_feed.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <opencv2/core.hpp>
@@ -36,15 +39,17 @@ cv::Mat paint_classes(const cv::Mat& train_ids) {
 SimCameraFeed::SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOptions& camera,
                              SimCameraImage image, float depth_scale,
                              common::SpscRing<common::ImageFrame>& colour_ring,
-                             common::SpscRing<common::ImageFrame>& depth_ring,
-                             SimCameraOutput output)
+                             common::SpscRing<common::ImageFrame>& depth_ring, double period_s,
+                             SimCameraOutput output, int render_nice)
     : world_(world),
       camera_(camera),
       image_(image),
       depth_scale_(depth_scale),
       colour_ring_(colour_ring),
       depth_ring_(depth_ring),
-      output_(std::move(output)) {}
+      period_s_(period_s),
+      output_(std::move(output)),
+      render_nice_(render_nice) {}
 
 SimCameraFeed::~SimCameraFeed() { stop(); }
 
@@ -70,7 +75,7 @@ void SimCameraFeed::request(const Eigen::Isometry3f& world_from_optical, common:
 }
 
 double SimCameraFeed::request_ahead_s() const {
-  return output_.device ? output_.period_s + output_lead_s() : 0.0;
+  return output_.device ? output_.period_s + output_lead_s() : period_s_;
 }
 
 std::optional<cv::Mat> SimCameraFeed::true_labels(std::uint32_t sequence) const {
@@ -102,6 +107,11 @@ double SimCameraFeed::render_seconds_mean() const {
 }
 
 void SimCameraFeed::run(std::stop_token stop) {
+  // Linux: the calling thread's nice value. A refusal only leaves it at the process's.
+  if (render_nice_ > 0 &&
+      setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), render_nice_) != 0) {
+    common::logger("sim_camera")->warn("renderer nice {} refused", render_nice_);
+  }
   std::uint32_t sequence = 0;
   while (true) {
     Request request;
@@ -121,26 +131,36 @@ void SimCameraFeed::run(std::stop_token stop) {
       std::lock_guard lock(mutex_);
       truth_.emplace_back(sequence, frame.labels);
       if (truth_.size() > kTruthKept) truth_.pop_front();
+    }
+    // Rendered ahead for a stamp the run did not reach, the frame was never taken: not counted.
+    if (!publish(frame, request.stamp, sequence, stop)) return;
+    {
+      std::lock_guard lock(mutex_);
       ++rendered_;
       render_seconds_ += seconds;
     }
-    publish(frame, request.stamp, sequence, stop);
     ++sequence;
   }
 }
 
-void SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
+bool SimCameraFeed::publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
                             std::stop_token stop) {
   const cv::Mat colour = image_ == SimCameraImage::kRgb ? frame.bgr : paint_classes(frame.labels);
+  common::ImageFrame depth = drivers::to_frame(sim::depth_to_z16(frame.depth_m, depth_scale_),
+                                               common::PixelFormat::kZ16, stamp, sequence);
   if (!output_.device) {
-    colour_ring_.try_push(drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence));
+    common::ImageFrame bgr =
+        drivers::to_frame(colour, common::PixelFormat::kBgr24, stamp, sequence);
+    if (!wait_until(stamp, stop)) return false;
+    delivery_age_.record(common::seconds_between(common::Stamp::now(), stamp));
+    colour_ring_.try_push(std::move(bgr));
   } else if (!show(colour, stamp, stop)) {
     std::lock_guard lock(mutex_);
     ++not_shown_;
-    return;
+    return true;
   }
-  depth_ring_.try_push(drivers::to_frame(sim::depth_to_z16(frame.depth_m, depth_scale_),
-                                         common::PixelFormat::kZ16, stamp, sequence));
+  depth_ring_.try_push(std::move(depth));
+  return true;
 }
 
 // Writes the frame to the output `period - tolerance` before its stamp (see SimCameraOutput);
@@ -149,13 +169,7 @@ bool SimCameraFeed::show(const cv::Mat& colour, common::Stamp stamp, std::stop_t
   const common::Stamp due = stamp + (-output_lead_s());
   const double allowance = output_.period_s - 2.0 * output_.tolerance_s;
   if (common::Stamp::now() > due + 0.5 * allowance) return false;
-  {
-    std::unique_lock lock(mutex_);
-    const auto wait = std::chrono::nanoseconds(
-        std::max<std::int64_t>(0, static_cast<std::int64_t>(due.ns - common::Stamp::now().ns)));
-    wake_.wait_for(lock, stop, wait, [] { return false; });
-  }
-  if (stop.stop_requested()) return false;
+  if (!wait_until(due, stop)) return false;
   try {
     if (output_.device->write({colour.data, colour.total() * colour.elemSize()}, colour.step,
                               100)) {
@@ -166,6 +180,14 @@ bool SimCameraFeed::show(const cv::Mat& colour, common::Stamp stamp, std::stop_t
     common::logger("sim_camera")->warn("camera frame not shown: {}", e.what());
   }
   return false;
+}
+
+bool SimCameraFeed::wait_until(common::Stamp due, std::stop_token stop) {
+  std::unique_lock lock(mutex_);
+  const auto wait = std::chrono::nanoseconds(
+      std::max<std::int64_t>(0, static_cast<std::int64_t>(due.ns - common::Stamp::now().ns)));
+  wake_.wait_for(lock, stop, wait, [] { return false; });
+  return !stop.stop_requested();
 }
 
 }  // namespace semap::sim

@@ -156,6 +156,11 @@ std::filesystem::path SimReport::write(onboard::Pipeline& pipeline) const {
   figures.frames_captured = rig_.camera().rendered();
   figures.frames_mapped = pipeline.mapping().scans;
   figures.latency_frame_to_map = pipeline.mapping_stage().latency().percentiles();
+  figures.latency_phases = {{"delivered", rig_.camera().delivery_age().percentiles()}};
+  for (auto& phase :
+       onboard::latency_phases(pipeline.perception_stage(), pipeline.mapping_stage())) {
+    figures.latency_phases.push_back(std::move(phase));
+  }
   figures.ring_drops = pipeline.ring_drops();
   figures.cpu_cores_used = pipeline.cpu_cores();
   return write(figures, pipeline.map(), pipeline.estimation());
@@ -334,6 +339,13 @@ std::filesystem::path SimReport::write(const RunFigures& run, const mapping::Sem
   }
   const auto& latency = run.latency_frame_to_map;
   const bool have_latency = latency.count > 0;
+  std::ostringstream phases;
+  for (const auto& [name, ms] : run.latency_phases) {
+    if (ms.count == 0) continue;
+    phases << (phases.tellp() > 0 ? ",\n    \"" : "\n    \"") << name
+           << "\": {\"p50\": " << number(ms.p50_ms, 1) << ", \"p99\": " << number(ms.p99_ms, 1)
+           << ", \"max\": " << number(ms.max_ms, 1) << ", \"count\": " << ms.count << "}";
+  }
   // One key per line, the last one without a comma: scripts/demo appends "listener".
   std::ostringstream json;
   json << "{\n"
@@ -354,6 +366,7 @@ std::filesystem::path SimReport::write(const RunFigures& run, const mapping::Sem
        << number(have_latency ? std::optional<double>(latency.p50_ms) : std::nullopt, 1)
        << ", \"p99\": "
        << number(have_latency ? std::optional<double>(latency.p99_ms) : std::nullopt, 1) << "},\n"
+       << "  \"latency_phases_ms\": {" << phases.str() << "},\n"
        << "  \"ring_drops\": {" << drops.str() << "},\n"
        << "  \"cpu_cores_used\": " << number(run.cpu_cores_used, 2) << "\n"
        << "}\n";

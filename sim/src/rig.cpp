@@ -74,9 +74,9 @@ SimRig::SimRig(const onboard::OnboardConfig& config, const SimRigConfig& sim,
                                     sim.camera_output, output.device->card(), c.width, c.height,
                                     1e3 * (output.period_s - output.tolerance_s));
   }
-  camera_ =
-      std::make_unique<SimCameraFeed>(world_, camera, sim.camera_image, config.depth.depth_scale,
-                                      rings.colour, rings.depth, std::move(output));
+  camera_ = std::make_unique<SimCameraFeed>(world_, camera, sim.camera_image,
+                                            config.depth.depth_scale, rings.colour, rings.depth,
+                                            camera_period_s_, std::move(output), sim.render_nice);
   // Shown on a V4L2 output, the colour frames come back through the camera's driver.
   if (!sim.camera_output.empty()) drivers_.add_camera(config.camera.driver, rings.colour);
   sim::EmulatorConfig emu;

@@ -31,6 +31,7 @@ void read_keys(const ConfigSection& s, SimRigConfig& rig) {
                          ? SimCameraImage::kRgb
                          : SimCameraImage::kClasses;
   rig.camera_output = s.get<std::string>("camera_output", "");
+  rig.render_nice = static_cast<int>(s.get_in_range("render_nice", rig.render_nice, 0, 19));
 }
 
 // rig.faults: scheduled windows; a window needs both its start and its length.

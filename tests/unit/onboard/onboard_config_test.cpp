@@ -69,6 +69,7 @@ TEST(OnboardConfig, SimulatedRigExample) {
   EXPECT_EQ(sim_rig.camera_image, sim::SimCameraImage::kRgb);
   EXPECT_EQ(sim_rig.trajectory.scenario, sim::Scenario::kFigureEight);
   EXPECT_EQ(sim_rig.scene_seed, 7u);
+  EXPECT_EQ(sim_rig.render_nice, 0);  // the default: no priority below the pipeline's
   EXPECT_DOUBLE_EQ(c.map.start_heading_sigma_deg, 3.0);
   const auto segmenter = make_segmenter(c.segmenter, c.map.params.num_classes);
   EXPECT_EQ(segmenter->num_classes(), c.map.params.num_classes);
@@ -258,6 +259,7 @@ TEST(OnboardConfig, EachBadKeyIsNamedWithItsFileAndLine) {
        "/nonexistent/run does not exist"},
       {"  kind: sim", "  kind: sim\n  pace: slow", "rig.pace", "slow"},
       {"  speed_m_s: 5", "  speed_m_s: 90", "rig.speed_m_s", "out of range"},
+      {"  world_density: 1.0", "  render_nice: 40", "rig.render_nice", "out of range"},
       {"  fps: 15", "  fps: 0", "camera.fps", "out of range"},
       {"  mount_xyz: [0.3, 0, 1.5]", "  mount_xyz: [0.3]", "camera.mount_xyz",
        "expected 3 numbers, got 1"},

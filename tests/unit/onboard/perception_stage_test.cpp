@@ -149,11 +149,18 @@ TEST_F(PerceptionStageTest, WaitsForTheFilterToReachTheFrame) {
   stage->step();
   EXPECT_TRUE(clouds_.empty());  // newer than the filter: held, not dropped
   EXPECT_EQ(stage->stats().without_pose, 0u);
+  EXPECT_EQ(stage->pose_wait().percentiles().count, 0u);
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
   poses_.append(drive(2.01, 3.0));
   stage->step();
   LabeledCloud cloud;
   ASSERT_TRUE(clouds_.try_pop(cloud));
   EXPECT_NEAR(cloud.origin.x() - camera_.mount_xyz.x(), 5.0f, 1e-3f);
+  // The wait is in the latency phases: from being queued for its pose until posed.
+  const auto wait = stage->pose_wait().percentiles();
+  EXPECT_EQ(wait.count, 1u);
+  EXPECT_GE(wait.max_ms, 30.0f);
+  EXPECT_EQ(stage->taken_age().percentiles().count, 1u);
 }
 
 TEST_F(PerceptionStageTest, CountsFramesWithoutAPose) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -67,11 +68,18 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   void start(std::vector<int> cpus = {});
   void stop();
   MappingStageStats stats() const;
-  // Age of each cloud (its image's capture stamp) once it is in the map; clouds held from
-  // before the heading was known (older than one already mapped) are left out.
+  // Age of each cloud (its image's capture stamp) once its cells are in the map (readable by
+  // the publisher); clouds held from before the heading was known (older than one already
+  // mapped) are left out.
   const common::LatencyWindow& latency() const { return latency_; }
-  // Time each insert took.
+  // Time each insert took, from taking the cloud (its wait for the map's lock included) until
+  // its cells are in the map.
   const common::LatencyWindow& insert_time() const { return insert_time_; }
+  // Where the age comes from before the insert: each live cloud's age (its image's capture
+  // stamp) when the stage takes it from its ring, and how long the insert then waited for the
+  // map's lock (the publisher's readers).
+  const common::LatencyWindow& taken_age() const { return taken_age_; }
+  const common::LatencyWindow& lock_wait() const { return lock_wait_; }
   // The map's blocks as the publisher sends them; safe from any thread. A paged-out block is
   // read from the checkpoint log; for_each_block lists the blocks in memory.
   const dds_idl::BlockSource& blocks() const { return *this; }
@@ -119,9 +127,12 @@ class MappingStage : private dds_idl::BlockSource, private CostmapSource {
   std::unordered_map<common::BlockIndex, std::uint32_t, common::BlockIndexHash> versions_;
   common::LatencyWindow latency_;
   common::Stamp newest_mapped_;  // clouds older than this were held back: not in latency_
+  common::LatencyWindow taken_age_;
+  common::LatencyWindow lock_wait_;
   common::LatencyWindow insert_time_;
-  std::unique_ptr<WriteFailureLog> write_log_;  // with a checkpoint
-  StageThread<MappingStageStats> stage_;        // last: joined before the members it uses
+  std::chrono::steady_clock::time_point stats_taken_;  // figures().map last counted
+  std::unique_ptr<WriteFailureLog> write_log_;         // with a checkpoint
+  StageThread<MappingStageStats> stage_;               // last: joined before the members it uses
 };
 
 // The map's shape and its palette's class names and colours (0xRRGGBB), for MapInfo.

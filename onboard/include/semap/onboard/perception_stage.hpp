@@ -106,6 +106,11 @@ class PerceptionStage {
   PerceptionStageStats stats() const;
   // Age of each frame (its capture stamp) when its posed cloud goes to the mapping stage.
   const common::LatencyWindow& latency() const { return latency_; }
+  // Where that age comes from: the colour frame's age when the stage takes it from its ring
+  // (the camera's delivery and the ring's wait while the stage was busy), and how long each
+  // cloud waited for the filter to reach its stamp.
+  const common::LatencyWindow& taken_age() const { return taken_age_; }
+  const common::LatencyWindow& pose_wait() const { return pose_wait_; }
   // Time each segmentation took, and each turning of a segmented frame into points
   // (back-projecting depth, projecting a scan).
   const common::LatencyWindow& segment_time() const { return segment_time_; }
@@ -123,6 +128,7 @@ class PerceptionStage {
   struct BodyCloud {
     common::LabeledCloud cloud;  // body frame
     std::uint32_t sequence = 0;
+    common::Stamp queued_at;  // when it began to wait for its pose
     // Carrying labels: the frame's depth (metres), labelled once it is posed; the cloud holds
     // only the stamp until then.
     cv::Mat unlabelled_depth_m;
@@ -182,6 +188,8 @@ class PerceptionStage {
   std::uint64_t hold_dropped_seen_ = 0;          // hold_.dropped() already counted
   bool live_handed_over_ = false;                // held clouds go after the first live one
   common::LatencyWindow latency_;
+  common::LatencyWindow taken_age_;
+  common::LatencyWindow pose_wait_;
   common::LatencyWindow segment_time_;
   common::LatencyWindow points_time_;
   StageThread<PerceptionStageStats> stage_;  // last: joined before the members it uses

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/onboard/estimation_stage.hpp"
@@ -39,6 +40,21 @@ std::uint64_t drops(const R&... rings) {
 std::vector<StageFigures> stage_figures(const Rings& r, const EstimationStage& estimation,
                                         const PerceptionStage* perception,
                                         const MappingStage& mapping, const DdsOutputs& dds);
+
+// Where a frame's time goes on its way into the map, in pipeline order: ages (since the frame's
+// capture stamp) at each hand-over and the durations of the steps between, each as
+// percentiles of its last 1024 items (live frames; held ones are left out of the mapping
+// stage's). Ages: `frame_taken` (perception takes it from the camera ring), `cloud_out` (its
+// posed cloud goes into the cloud ring), `cloud_taken` (the mapping stage takes it), `in_map`.
+// Durations: `segment`, `points` (back-projection), `pose_wait` (until the filter reaches the
+// stamp), `lock_wait` (the map's lock, held by the publisher's readers) and `insert` (with
+// its lock wait).
+struct LatencyPhase {
+  std::string name;
+  common::LatencyPercentiles ms;
+};
+std::vector<LatencyPhase> latency_phases(const PerceptionStage* perception,
+                                         const MappingStage& mapping);
 
 // Rates over the last interval, ring depths and drops: the progress line every few seconds.
 class Progress {

@@ -9,6 +9,7 @@
 #include <optional>
 #include <thread>
 
+#include "semap/common/latency_window.hpp"
 #include "semap/common/messages.hpp"
 #include "semap/common/spsc_ring.hpp"
 #include "semap/drivers/v4l2_output.hpp"
@@ -44,12 +45,18 @@ struct SimCameraOutput {
 // pushes a BGR24 colour frame and an aligned Z16 depth frame into the rings the camera drivers
 // fill on hardware (the colour frame to a V4L2 output instead when one is given). It keeps the
 // true classes of recent frames for evaluation.
+// Frames for the rings are asked for `period_s` (a frame period) ahead of their stamp and
+// pushed at it, as a camera hands over the image it took: rendering, which a camera does in
+// hardware, is then not part of the pipeline's latency unless it takes longer than a period (the
+// frame is pushed when done, its delay in delivery_age()). 0: rendered after the stamp.
+// `render_nice` (0..19) lowers the renderer thread's priority below the pipeline's threads.
 class SimCameraFeed {
  public:
   SimCameraFeed(const sim::SimWorld& world, const sim::SimCameraOptions& camera,
                 SimCameraImage image, float depth_scale,
                 common::SpscRing<common::ImageFrame>& colour_ring,
-                common::SpscRing<common::ImageFrame>& depth_ring, SimCameraOutput output = {});
+                common::SpscRing<common::ImageFrame>& depth_ring, double period_s = 0.0,
+                SimCameraOutput output = {}, int render_nice = 0);
   ~SimCameraFeed();
   SimCameraFeed(const SimCameraFeed&) = delete;
   SimCameraFeed& operator=(const SimCameraFeed&) = delete;
@@ -59,8 +66,8 @@ class SimCameraFeed {
   // A frame at this camera pose (world from optical) and capture stamp. A request the feed
   // has not started on yet is replaced by the newer one (counted as skipped).
   void request(const Eigen::Isometry3f& world_from_optical, common::Stamp stamp);
-  // How long before its stamp the rig should ask for a frame: 0 when frames go to the rings
-  // (rendered after the fact); with an output, a frame period to render it before it is due.
+  // How long before its stamp the rig should ask for a frame: a frame period to render it
+  // before it is due (to the rings: the period given, at the stamp; to an output: earlier).
   double request_ahead_s() const;
 
   // True classes (CV_8UC1, Cityscapes train ids) of a recent frame, by its sequence number.
@@ -69,6 +76,9 @@ class SimCameraFeed {
   std::uint64_t skipped() const;
   std::uint64_t not_shown() const;  // rendered but not written to the output (late, errors)
   double render_seconds_mean() const;
+  // Each frame's age (since its capture stamp) when it goes into the rings: the wait for the
+  // renderer and the rendering, which a real camera does in hardware.
+  const common::LatencyWindow& delivery_age() const { return delivery_age_; }
 
  private:
   struct Request {
@@ -76,9 +86,12 @@ class SimCameraFeed {
     common::Stamp stamp;
   };
   void run(std::stop_token stop);
-  void publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
+  // False when stopped before a frame for the rings was due: it never went out.
+  bool publish(const sim::SimFrame& frame, common::Stamp stamp, std::uint32_t sequence,
                std::stop_token stop);
   bool show(const cv::Mat& colour, common::Stamp stamp, std::stop_token stop);
+  // Sleeps until `due`; false when asked to stop.
+  bool wait_until(common::Stamp due, std::stop_token stop);
   double output_lead_s() const { return output_.period_s - output_.tolerance_s; }
 
   const sim::SimWorld& world_;
@@ -87,7 +100,9 @@ class SimCameraFeed {
   float depth_scale_;
   common::SpscRing<common::ImageFrame>& colour_ring_;
   common::SpscRing<common::ImageFrame>& depth_ring_;
+  double period_s_;
   SimCameraOutput output_;
+  int render_nice_;
   mutable std::mutex mutex_;
   std::condition_variable_any wake_;
   std::optional<Request> pending_;
@@ -96,6 +111,7 @@ class SimCameraFeed {
   std::uint64_t skipped_ = 0;
   std::uint64_t not_shown_ = 0;
   double render_seconds_ = 0.0;
+  common::LatencyWindow delivery_age_;
   std::jthread thread_;
 };
 

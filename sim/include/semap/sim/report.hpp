@@ -15,6 +15,7 @@
 #include "semap/mapping/confusion_matrix.hpp"
 #include "semap/onboard/estimation_stage.hpp"
 #include "semap/onboard/pipeline.hpp"
+#include "semap/onboard/run_figures.hpp"
 #include "semap/perception/segmentation.hpp"
 #include "semap/perception/sim_classes.hpp"
 #include "semap/sim/rig.hpp"
@@ -62,6 +63,8 @@ struct RunFigures {
   std::uint64_t frames_captured = 0;  // rendered by the rig's camera
   std::uint64_t frames_mapped = 0;    // clouds inserted into the map
   common::LatencyPercentiles latency_frame_to_map;
+  // Where it comes from: the camera's delivery, then onboard::latency_phases().
+  std::vector<onboard::LatencyPhase> latency_phases;
   std::vector<std::pair<std::string, std::uint64_t>> ring_drops;
   double cpu_cores_used = 0.0;
 };
@@ -73,8 +76,8 @@ struct RunFigures {
 // IMU stamp, `stamp_s,x,y,z` as --trajectory writes the estimate, for a test to score the
 // published poses itself) and summary.json (pose RMSE, pixel mIoU of the segmenter, mIoU of the
 // map's occupied cells against the world's true class at each cell centre (and over the cells
-// on a surface alone), frame counts, latency, ring drops, CPU), written by write() after the
-// pipeline stopped.
+// on a surface alone), frame counts, latency and its phases, ring drops, CPU), written by write()
+// after the pipeline stopped.
 class SimReport final : public onboard::PipelineObserver {
  public:
   SimReport(const SimRig& rig, std::filesystem::path dir);

@@ -17,6 +17,11 @@ struct SimRigConfig {
   std::uint32_t scene_seed = 7;  // the street world and the camera's noise
   double world_density = 1.0;    // scales the number of buildings, trees, cars and poles
   SimCameraImage camera_image = SimCameraImage::kRgb;
+  // Nice value of the camera's renderer thread (0..19). The renderer stands for a camera's
+  // hardware; > 0 puts the pipeline's threads first on the CPUs they share (the latency
+  // benchmark uses 10). 0 by default: on a machine shared with other work a niced renderer
+  // falls behind the camera rate, and the tests count frames rendered.
+  int render_nice = 0;
   // A V4L2 video output device (vivid's, looped to its capture side): the rig writes its colour
   // frames there as BGR24 and a CameraDriver on camera.device captures them back. Empty: the
   // frames go straight into the colour ring.
