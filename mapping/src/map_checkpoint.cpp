@@ -145,19 +145,46 @@ MapCheckpoint::Stats MapCheckpoint::stats() const {
 }
 
 MapPager::MapPager(SemanticMap& map, BlockLog& log, double radius_m)
-    : map_(map), log_(log), radius_(radius_m) {
+    : map_(map),
+      log_(log),
+      radius_(radius_m),
+      region_side_(static_cast<std::int32_t>(
+          std::clamp(std::ceil(radius_m / map.params().grid().block_size()), 1.0, 1024.0))) {
   // A radius of zero or less would write out every block before each insert and read it
   // back right after (as a late restore): a wrong config, not a small memory budget.
   if (!(radius_m > 0.0)) throw std::invalid_argument("MapPager: radius must be positive");
   for (const common::BlockIndex& index : log_.blocks()) {
-    if (map_.find_block(index) == nullptr) out_.insert(index);
+    if (map_.find_block(index) == nullptr) mark_out(index);
   }
+}
+
+common::BlockIndex MapPager::region_of(const common::BlockIndex& index) const {
+  return {common::floor_div(index.x, region_side_), common::floor_div(index.y, region_side_),
+          common::floor_div(index.z, region_side_)};
+}
+
+void MapPager::mark_out(const common::BlockIndex& index) {
+  out_[region_of(index)].push_back(index);
+  ++paged_out_;
+}
+
+bool MapPager::take_out(const common::BlockIndex& index) {
+  const auto region = out_.find(region_of(index));
+  if (region == out_.end()) return false;
+  std::vector<common::BlockIndex>& blocks = region->second;
+  const auto at = std::find(blocks.begin(), blocks.end(), index);
+  if (at == blocks.end()) return false;
+  *at = blocks.back();
+  blocks.pop_back();
+  if (blocks.empty()) out_.erase(region);
+  --paged_out_;
+  return true;
 }
 
 void MapPager::after_insert(const InsertResult& result) {
   for (const common::BlockIndex& index : result.updated_blocks) {
     // The insert started this block again from zero: add its evidence from the log.
-    if (out_.erase(index) == 1) {
+    if (take_out(index)) {
       log_.load(index, map_);
       ++stats_.restored;
       ++stats_.late_restores;
@@ -191,17 +218,28 @@ std::vector<common::BlockIndex> MapPager::update(const Eigen::Vector3f& robot) {
     }
     stats_.failing = false;
     map_.evict(index);
-    out_.insert(index);
+    mark_out(index);
     evicted.push_back(index);
     ++stats_.evicted;
   }
+  // Blocks within the radius lie in the robot's region or its 26 neighbours (a region is at
+  // least the radius wide).
   std::vector<common::BlockIndex> near;
-  for (const common::BlockIndex& index : out_) {
-    if (distance(index) <= radius_) near.push_back(index);
+  const common::BlockIndex centre = region_of(grid.block_of(grid.cell_of(robot)));
+  for (std::int32_t dz = -1; dz <= 1; ++dz) {
+    for (std::int32_t dy = -1; dy <= 1; ++dy) {
+      for (std::int32_t dx = -1; dx <= 1; ++dx) {
+        const auto region = out_.find({centre.x + dx, centre.y + dy, centre.z + dz});
+        if (region == out_.end()) continue;
+        for (const common::BlockIndex& index : region->second) {
+          if (distance(index) <= radius_) near.push_back(index);
+        }
+      }
+    }
   }
   for (const common::BlockIndex& index : near) {
     log_.load(index, map_);
-    out_.erase(index);
+    take_out(index);
     ++stats_.restored;
   }
   return evicted;

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -147,14 +148,24 @@ class MapPager {
   // the log is added back, so nothing is lost.
   void after_insert(const InsertResult& result);
   // Blocks in the log and not in memory.
-  std::size_t paged_out() const { return out_.size(); }
+  std::size_t paged_out() const { return paged_out_; }
   const Stats& stats() const { return stats_; }
 
  private:
   SemanticMap& map_;
   BlockLog& log_;
   double radius_;
-  std::unordered_set<common::BlockIndex, common::BlockIndexHash> out_;
+  void mark_out(const common::BlockIndex& index);
+  // Removes `index` from the paged-out blocks; false when it is not among them.
+  bool take_out(const common::BlockIndex& index);
+  common::BlockIndex region_of(const common::BlockIndex& index) const;
+
+  // Paged-out blocks by region (cubes of region_side_ blocks, about the radius), so that an
+  // update looks at the 27 regions around the robot, not at every block a long drive left.
+  std::unordered_map<common::BlockIndex, std::vector<common::BlockIndex>, common::BlockIndexHash>
+      out_;
+  std::size_t paged_out_ = 0;
+  std::int32_t region_side_;
   Stats stats_;
 };
 
